@@ -1,0 +1,58 @@
+# humanmpc: the README's commands.
+#   make test   install what is missing (apt packages as root, .venv, pip) and run the whole suite
+#   make demo   generate + build the solver of the built-in default spec and show what was built
+SHELL := /bin/bash
+.DEFAULT_GOAL := help
+
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+GEN := $(VENV)/bin/humanmpc-gen
+STAMP := $(VENV)/.installed
+
+# Debian packages the suite needs: compilers (gcc, clang + its sanitizer/fuzzer runtime), make and
+# CMake for the generated package, binutils for nm, valgrind, Python venv support.
+APT_PACKAGES := gcc clang libclang-rt-14-dev make cmake binutils valgrind python3-venv python3-dev
+
+.PHONY: help test demo system-deps venv lint clean
+
+help:
+	@echo "make test   - set up everything on a fresh Debian machine and run the whole test suite"
+	@echo "make demo   - generate and build the solver of the built-in default spec"
+	@echo "make lint   - ruff and mypy"
+
+system-deps:
+	@missing=""; for p in $(APT_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  echo "[setup] installing Debian packages:$$missing"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=""; elif command -v sudo >/dev/null; then SUDO="sudo"; \
+	  else echo "[setup] need root to install:$$missing" >&2; exit 1; fi; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq \
+	    --no-install-recommends $$missing >/dev/null || exit 1; \
+	fi
+
+$(STAMP): pyproject.toml
+	@echo "[setup] creating $(VENV) and installing humanmpc[test]"
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	@$(PY) -m pip install -q --upgrade pip
+	@$(PY) -m pip install -q -e '.[test]'
+	@touch $@
+
+venv: system-deps $(STAMP)
+
+test: venv
+	$(PY) -m ruff check codegen python tests
+	$(PY) -m pytest tests
+
+demo: venv
+	$(GEN) generate -o generated/paper --force
+	$(GEN) build generated/paper
+
+lint: venv
+	$(PY) -m ruff check codegen python tests
+	$(PY) -m mypy codegen python
+
+clean:
+	rm -rf build generated/*/ .pytest_cache .ruff_cache .mypy_cache .hypothesis

@@ -1,0 +1,11 @@
+/*
+ * hm_aliases.h: short names for the sized types of hm_types.h, for use inside the runtime.
+ * Included once by the translation unit that compiles the runtime, with HM_NS still defined.
+ */
+#ifndef HM_ALIASES_H
+#define HM_ALIASES_H
+
+typedef HM_NS(ocp_qp) hm_ocp_qp;
+typedef HM_NS(ocp_qp_sol) hm_ocp_qp_sol;
+
+#endif /* HM_ALIASES_H */

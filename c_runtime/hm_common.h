@@ -1,0 +1,65 @@
+/*
+ * hm_common.h: what every part of the humanmpc C runtime shares, independent of any solver's sizes.
+ *
+ * The runtime is compiled inside each generated solver's single translation unit (see
+ * docs/ARCHITECTURE.md): the including file defines hm_real, the size macros HM_N and HM_NG, and
+ * HM_NS (the type-name prefix), then includes the runtime .c files. Every runtime function is
+ * HM_FUNC (static), so two solvers with different sizes link into one binary without clashes.
+ */
+#ifndef HM_COMMON_H
+#define HM_COMMON_H
+
+#include <math.h>
+#include <stddef.h>
+
+/* The robot model is fixed by the product: unicycle state [px, py, theta, v], control [a, omega].
+ * General (distance) rows touch only the position [px, py]. */
+#define HM_NX 4
+#define HM_NU 2
+#define HM_NP 2
+
+/* Runtime functions are private to the translation unit that includes them. */
+#ifndef HM_FUNC
+#define HM_FUNC static
+#endif
+
+#define HM_CONCAT_(a, b) a##b
+#define HM_CONCAT(a, b) HM_CONCAT_(a, b)
+
+/* Single precision is selected with HM_REAL_IS_FLOAT; all literals go through HM_R so that a float
+ * build never promotes to double (an explicit cast of a constant is folded at compile time), and
+ * all math goes through these wrappers. */
+#ifdef HM_REAL_IS_FLOAT
+#define HM_R(x) ((float)(x))
+#define hm_sqrt sqrtf
+#define hm_fabs fabsf
+#define hm_exp expf
+#define hm_fmax fmaxf
+#define hm_fmin fminf
+#define HM_EPS 1.1920929e-07f
+#define HM_INF 1.0e30f
+#else
+#define HM_R(x) ((double)(x))
+#define hm_sqrt sqrt
+#define hm_fabs fabs
+#define hm_exp exp
+#define hm_fmax fmax
+#define hm_fmin fmin
+#define HM_EPS 2.220446049250313e-16
+#define HM_INF 1.0e30
+#endif
+
+/* A bound whose magnitude reaches HM_INF is absent (no row is created for it). */
+#define HM_IS_INF(x) (hm_fabs(x) >= HM_INF)
+
+/* Status of a QP solve. Fixed values: they are part of the public C and Python API. */
+enum hm_qp_status {
+    HM_QP_SOLVED = 0,      /* converged to the requested tolerance */
+    HM_QP_MAX_ITER = 1,    /* iteration limit reached before convergence */
+    HM_QP_INFEASIBLE = 2,  /* no point satisfies the hard constraints */
+    HM_QP_NUMERICAL = 3,   /* factorisation failed or the iterates stopped making progress */
+    HM_QP_NONFINITE = 4,   /* NaN or Inf in the data or produced during the solve */
+    HM_QP_TIMEOUT = 5      /* the caller's stop hook fired (deadline) */
+};
+
+#endif /* HM_COMMON_H */
