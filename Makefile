@@ -49,6 +49,7 @@ test: venv
 demo: venv
 	$(GEN) generate -o generated/paper --force
 	$(GEN) build generated/paper
+	$(GEN) info generated/paper
 
 lint: venv
 	$(PY) -m ruff check codegen python tests

@@ -1,1 +1,12 @@
+"""humanmpc: human-aware navigation MPC, generated as fixed-size C and driven from Python.
 
+    import humanmpc
+    solver = humanmpc.load("generated/paper")      # builds the library first if needed
+    x_next, A, B = solver.model.dynamics(x, u)
+"""
+
+from humanmpc.codegen import __version__
+
+from .bindings import Dims, LoadError, Solver, load
+
+__all__ = ["Dims", "LoadError", "Solver", "__version__", "load"]

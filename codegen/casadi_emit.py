@@ -1,0 +1,102 @@
+"""CasADi code generation of the model functions, and the mechanical fixes its C needs.
+
+CasADi's output is correct but made for one solver per program: two helpers (casadi_sq, ...)
+are global, and its evaluation signature passes work vectors a function may not use. The fixes
+below make every helper static and mark each parameter as used, so that the file compiles under
+-Wall -Wextra -pedantic -Werror and two solvers link into one binary. They are applied to the
+text CasADi wrote and checked by the compile and nm tests.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import casadi as ca
+
+from .ocp import ModelFunction
+
+# A function definition: return type and name, the parameter list, and its opening brace.
+_DEFINITION = re.compile(
+    r"^(?P<head>(?:static |CASADI_SYMBOL_EXPORT )?[A-Za-z_][\w \*]*?\b(?P<name>[A-Za-z_]\w*)"
+    r"\((?P<params>[^;{}()]*)\)\s*\{)",
+    re.MULTILINE,
+)
+# A file-scope helper CasADi leaves global, e.g. "casadi_real casadi_sq(casadi_real x) {".
+_GLOBAL_HELPER = re.compile(r"^(?!static )(?!CASADI_SYMBOL_EXPORT )([A-Za-z_][\w \*]*\bcasadi_\w+\()", re.MULTILINE)
+
+
+@dataclass(frozen=True)
+class EmittedFunction:
+    model: ModelFunction
+    casadi_name: str  # the C symbol CasADi generated, e.g. paper_model_dynamics
+    sz_arg: int
+    sz_res: int
+    sz_iw: int
+    sz_w: int
+
+
+def _param_names(params: str) -> list[str]:
+    names = []
+    for decl in params.split(","):
+        decl = decl.strip()
+        if not decl or decl == "void":
+            continue
+        names.append(re.findall(r"[A-Za-z_]\w*", decl)[-1])
+    return names
+
+
+def make_parameters_used(source: str) -> str:
+    def mark(m: re.Match[str]) -> str:
+        casts = "".join(f" (void){n};" for n in _param_names(m.group("params")))
+        return m.group("head") + casts
+
+    return _DEFINITION.sub(mark, source)
+
+
+def make_helpers_static(source: str) -> str:
+    return _GLOBAL_HELPER.sub(r"static \1", source)
+
+
+def emit_model(functions: tuple[ModelFunction, ...], prefix: str, real: str, out_dir: Path) -> list[EmittedFunction]:
+    """Write {prefix}_model.c/.h into out_dir; return what the templates need of each function."""
+    basename = f"{prefix}_model"
+    cg = ca.CodeGenerator(
+        f"{basename}.c",
+        {
+            "with_header": True,
+            "casadi_int": "int",
+            "casadi_real": real,
+            "prefix": f"{prefix}_casadi",  # CasADi appends "_"
+            "main": False,
+            "mex": False,
+            "cpp": False,
+        },
+    )
+    emitted = []
+    for mf in functions:
+        casadi_name = f"{prefix}_model_{mf.name}"
+        fn = mf.function
+        # Rebuild under the prefixed name: CasADi names the C symbol after the Function.
+        renamed = ca.Function(casadi_name, fn.sx_in(), fn.call(fn.sx_in()), fn.name_in(), fn.name_out())
+        cg.add(renamed)
+        emitted.append(
+            EmittedFunction(
+                model=mf,
+                casadi_name=casadi_name,
+                sz_arg=max(1, renamed.sz_arg()),
+                sz_res=max(1, renamed.sz_res()),
+                sz_iw=max(1, renamed.sz_iw()),
+                sz_w=max(1, renamed.sz_w()),
+            )
+        )
+    cg.generate(str(out_dir) + "/")
+    banner = (
+        f"/* {basename}.c: model functions of the humanmpc solver \"{prefix}\", written by CasADi "
+        f"{ca.CasadiMeta.version()}\n * and adjusted mechanically by humanmpc (static helpers, parameters marked "
+        "used). Do not edit. */\n"
+    )
+    c_file = out_dir / f"{basename}.c"
+    c_file.write_text(banner + make_helpers_static(make_parameters_used(c_file.read_text())))
+    return emitted

@@ -1,0 +1,407 @@
+"""The problem spec: schema, defaults (the paper's values), validation and the resolved form.
+
+The schema is the set of frozen dataclasses below; each field carries its rule in its metadata, so
+the defaults, the types and the checks live in one place. ``load_spec`` / ``resolve_spec`` return a
+``Spec`` or raise ``SpecError`` listing every problem found, each naming the key path, the value
+and the rule broken. Everything that reaches generated C from a spec passes through here: names
+must be C identifiers (and not keywords), numbers must be finite and in range.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import hashlib
+import json
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, cast
+
+import yaml
+
+
+class SpecError(ValueError):
+    """A spec that cannot be used; ``problems`` holds one line per broken rule."""
+
+    def __init__(self, problems: Sequence[str], source: str = "spec") -> None:
+        self.problems = list(problems)
+        self.source = source
+        lines = "\n".join(f"  - {p}" for p in self.problems)
+        super().__init__(f"invalid {source}: {len(self.problems)} problem(s)\n{lines}")
+
+
+# --------------------------------------------------------------------------------------------
+# Field rules
+# --------------------------------------------------------------------------------------------
+
+# C99 and C11 keywords plus names that would collide with the runtime or the C library's macros
+# once the spec's name becomes a prefix.
+C_KEYWORDS = frozenset(
+    [
+        "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else",
+        "enum", "extern", "float", "for", "goto", "if", "inline", "int", "long", "register",
+        "restrict", "return", "short", "signed", "sizeof", "static", "struct", "switch", "typedef",
+        "union", "unsigned", "void", "volatile", "while", "_Alignas", "_Alignof", "_Atomic", "_Bool",
+        "_Complex", "_Generic", "_Imaginary", "_Noreturn", "_Static_assert", "_Thread_local", "asm",
+        "bool", "true", "false", "NULL",
+    ]
+)
+RESERVED_NAMES = frozenset({"hm", "casadi", "humanmpc", "main", "errno", "assert"})
+IDENT_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+MAX_NAME_LEN = 31
+
+
+@dataclass(frozen=True)
+class Rule:
+    """How one spec value is checked. ``kind``: number, integer, vector, interval, choice, name."""
+
+    kind: str
+    doc: str
+    gt: float | None = None
+    ge: float | None = None
+    le: float | None = None
+    length: int | None = None
+    choices: tuple[str, ...] = ()
+
+    def check(self, path: str, value: Any) -> tuple[Any, list[str]]:
+        """Return the normalised value and the problems found (empty when valid)."""
+        checker = getattr(self, f"_check_{self.kind}")
+        return checker(path, value)
+
+    # -- scalars --------------------------------------------------------------------------------
+    def _range_problems(self, path: str, value: float | int) -> list[str]:
+        if self.gt is not None and not value > self.gt:
+            return [f"{path}: {value!r} is out of range: must be > {self.gt:g}"]
+        if self.ge is not None and not value >= self.ge:
+            return [f"{path}: {value!r} is out of range: must be >= {self.ge:g}"]
+        if self.le is not None and not value <= self.le:
+            return [f"{path}: {value!r} is out of range: must be <= {self.le:g}"]
+        return []
+
+    def _check_number(self, path: str, value: Any) -> tuple[Any, list[str]]:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return None, [f"{path}: {value!r} has the wrong type: must be a number"]
+        x = float(value)
+        if not math.isfinite(x):
+            return None, [f"{path}: {value!r} is not finite: must be a finite number"]
+        return x, self._range_problems(path, x)
+
+    def _check_integer(self, path: str, value: Any) -> tuple[Any, list[str]]:
+        if isinstance(value, bool) or not isinstance(value, int):
+            return None, [f"{path}: {value!r} has the wrong type: must be an integer"]
+        return int(value), self._range_problems(path, int(value))
+
+    # -- sequences ------------------------------------------------------------------------------
+    def _check_vector(self, path: str, value: Any) -> tuple[Any, list[str]]:
+        if not isinstance(value, (list, tuple)):
+            return None, [f"{path}: {value!r} has the wrong type: must be a list of {self.length} numbers"]
+        if len(value) != self.length:
+            return None, [f"{path}: {value!r} has {len(value)} entries: must have exactly {self.length}"]
+        out: list[float] = []
+        problems: list[str] = []
+        for i, v in enumerate(value):
+            x, p = self._check_number(f"{path}[{i}]", v)
+            problems += p
+            out.append(x)
+        return tuple(out), problems
+
+    def _check_interval(self, path: str, value: Any) -> tuple[Any, list[str]]:
+        if not isinstance(value, (list, tuple)) or len(value) != 2:
+            return None, [f"{path}: {value!r} is not an interval: must be [lower, upper]"]
+        lo, p_lo = Rule("number", self.doc)._check_number(f"{path}[0]", value[0])
+        hi, p_hi = Rule("number", self.doc)._check_number(f"{path}[1]", value[1])
+        problems = p_lo + p_hi
+        if not problems and not lo < hi:
+            problems.append(f"{path}: {list(value)!r} is reversed or empty: lower bound must be < upper bound")
+        return (lo, hi), problems
+
+    # -- strings --------------------------------------------------------------------------------
+    def _check_choice(self, path: str, value: Any) -> tuple[Any, list[str]]:
+        if not isinstance(value, str) or value not in self.choices:
+            return None, [f"{path}: {value!r} is not allowed: must be one of {', '.join(self.choices)}"]
+        return value, []
+
+    def _check_name(self, path: str, value: Any) -> tuple[Any, list[str]]:
+        if not isinstance(value, str):
+            return None, [f"{path}: {value!r} has the wrong type: must be a string (a C identifier)"]
+        if not IDENT_RE.match(value):
+            return None, [
+                f"{path}: {value!r} is not a C identifier: use a letter followed by letters, "
+                "digits or underscores"
+            ]
+        if len(value) > MAX_NAME_LEN:
+            return None, [f"{path}: {value!r} is too long: at most {MAX_NAME_LEN} characters"]
+        if value in C_KEYWORDS or value.lower() in RESERVED_NAMES:
+            return None, [f"{path}: {value!r} is reserved (a C keyword or a runtime prefix): choose another name"]
+        return value, []
+
+
+def _field(default: Any, rule: Rule) -> Any:
+    return field(default=default, metadata={"rule": rule})
+
+
+def number(default: float, doc: str, *, gt: float | None = None, ge: float | None = None,
+           le: float | None = None) -> Any:
+    return _field(default, Rule("number", doc, gt=gt, ge=ge, le=le))
+
+
+def integer(default: int, doc: str, *, ge: float | None = None, le: float | None = None) -> Any:
+    return _field(default, Rule("integer", doc, ge=ge, le=le))
+
+
+def vector(default: tuple[float, ...], doc: str, *, ge: float | None = None, le: float | None = None) -> Any:
+    return _field(default, Rule("vector", doc, ge=ge, le=le, length=len(default)))
+
+
+def interval(default: tuple[float, float], doc: str) -> Any:
+    return _field(default, Rule("interval", doc))
+
+
+def choice(default: str, doc: str, choices: tuple[str, ...]) -> Any:
+    return _field(default, Rule("choice", doc, choices=choices))
+
+
+# --------------------------------------------------------------------------------------------
+# The schema (defaults: the paper's experiment, section "Parameters and Model")
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Horizon:
+    T: float = number(5.0, "horizon length [s]", gt=0.0, le=600.0)
+    N: int = integer(50, "number of shooting intervals (a fixed size)", ge=1, le=1000)
+
+
+@dataclass(frozen=True)
+class Integrator:
+    method: str = choice("rk4", "integration scheme of the dynamics over one interval", ("rk4",))
+    steps: int = integer(1, "integrator steps per shooting interval", ge=1, le=100)
+
+
+@dataclass(frozen=True)
+class Humans:
+    max: int = integer(10, "N_h: how many humans the solver handles (a fixed size)", ge=0, le=200)
+    d_h: float = number(0.5, "hard minimum distance to a human's current position [m]", ge=0.0, le=100.0)
+
+
+@dataclass(frozen=True)
+class CollisionCost:
+    q: float = number(2.0, "height of the collision potential", ge=0.0, le=1e6)
+    d_th: float = number(1.0, "distance at which the potential is q/2 [m]", ge=0.0, le=100.0)
+    kappa: float = number(5.0, "steepness of the potential [1/m]", gt=0.0, le=1e3)
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    d_s: float = number(0.5, "soft minimum distance to the closest obstacle [m]", ge=0.0, le=100.0)
+    slack_l1: float = number(100.0, "L1 penalty on the obstacle slack", ge=0.0, le=1e9)
+    slack_l2: float = number(100.0, "L2 penalty on the obstacle slack (0.5*l2*s^2)", ge=0.0, le=1e9)
+
+
+@dataclass(frozen=True)
+class Weights:
+    goal: tuple[float, ...] = vector((0.5, 0.5, 0.0, 250.0), "stage weights on x - g", ge=0.0, le=1e9)
+    goal_terminal: tuple[float, ...] = vector(
+        (40.0, 40.0, 2.0, 0.0), "terminal weights on x_N - g", ge=0.0, le=1e9
+    )
+    control: tuple[float, ...] = vector((0.0, 0.0), "stage weights on u = [a, omega]", ge=0.0, le=1e9)
+
+
+@dataclass(frozen=True)
+class Bounds:
+    v: tuple[float, float] = interval((0.0, 1.0), "forward speed [m/s]")
+    a: tuple[float, float] = interval((-1.0, 1.0), "acceleration [m/s^2]")
+    omega: tuple[float, float] = interval((-1.5, 1.5), "turn rate [rad/s]")
+
+
+@dataclass(frozen=True)
+class Solver:
+    regularization: float = number(1e-6, "Levenberg-Marquardt term added to the QP Hessian", ge=0.0, le=1e3)
+    qp_max_iter: int = integer(50, "interior-point iteration limit per QP", ge=1, le=1000)
+    qp_tol: float = number(1e-6, "QP convergence tolerance", gt=0.0, le=1.0)
+
+
+@dataclass(frozen=True)
+class Monitor:
+    deadline_ms: float = number(20.0, "time allowed for one solver step [ms]", gt=0.0, le=1e5)
+
+
+@dataclass(frozen=True)
+class Spec:
+    name: str = _field("paper", Rule("name", "C identifier; prefix of every public C name"))
+    horizon: Horizon = field(default_factory=Horizon)
+    integrator: Integrator = field(default_factory=Integrator)
+    humans: Humans = field(default_factory=Humans)
+    collision_cost: CollisionCost = field(default_factory=CollisionCost)
+    obstacle: Obstacle = field(default_factory=Obstacle)
+    weights: Weights = field(default_factory=Weights)
+    bounds: Bounds = field(default_factory=Bounds)
+    solver: Solver = field(default_factory=Solver)
+    monitor: Monitor = field(default_factory=Monitor)
+
+    @property
+    def dt(self) -> float:
+        return self.horizon.T / self.horizon.N
+
+    @property
+    def n_rows(self) -> int:
+        """General rows per stage: one per human and one for the closest obstacle."""
+        return self.humans.max + 1
+
+    def to_dict(self) -> dict[str, Any]:
+        return _plain(dataclasses.asdict(self))
+
+    def to_yaml(self) -> str:
+        return yaml.safe_dump(self.to_dict(), sort_keys=False, default_flow_style=None)
+
+    def digest(self) -> str:
+        """SHA-256 of the resolved spec in canonical JSON: what a generated solver was made from."""
+        canonical = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(canonical.encode()).hexdigest()
+
+
+def _plain(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    return obj
+
+
+# --------------------------------------------------------------------------------------------
+# Validation
+# --------------------------------------------------------------------------------------------
+
+
+def _unknown_key_problem(path: str, key: Any, valid: Sequence[str]) -> str:
+    where = f"{path}.{key}" if path else str(key)
+    if not isinstance(key, str):
+        return f"{where}: key {key!r} is not a string: valid keys here are {', '.join(valid)}"
+    lowered = {v.lower(): v for v in valid}
+    guess = difflib.get_close_matches(key.lower(), list(lowered), n=1, cutoff=0.5)
+    hint = f"did you mean '{lowered[guess[0]]}'?" if guess else f"valid keys here are {', '.join(valid)}"
+    return f"{where}: unknown key: {hint}"
+
+
+def _resolve_section(cls: type, data: Any, path: str, problems: list[str]) -> Any:
+    if data is None:
+        data = {}
+    if not isinstance(data, Mapping):
+        problems.append(f"{path or 'spec'}: {data!r} has the wrong type: must be a mapping of keys to values")
+        return cls()
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    for key in data:
+        if key not in fields:
+            problems.append(_unknown_key_problem(path, key, list(fields)))
+    values: dict[str, Any] = {}
+    for name, f in fields.items():
+        if name not in data:
+            continue
+        sub_path = f"{path}.{name}" if path else name
+        rule = f.metadata.get("rule")
+        if rule is None:  # a nested section
+            section_cls = cast(type, f.default_factory)
+            values[name] = _resolve_section(section_cls, data[name], sub_path, problems)
+            continue
+        value, found = rule.check(sub_path, data[name])
+        problems += found
+        if not found:
+            values[name] = value
+    return cls(**values)
+
+
+def _cross_checks(spec: Spec) -> list[str]:
+    """Rules that involve more than one key."""
+    problems = []
+    lo, hi = spec.bounds.v
+    if lo > 0.0:
+        problems.append(f"bounds.v: {list(spec.bounds.v)!r} excludes standstill: the lower bound must be <= 0")
+    if hi <= 0.0:
+        problems.append(f"bounds.v: {list(spec.bounds.v)!r} allows no forward motion: the upper bound must be > 0")
+    for key in ("a", "omega"):
+        lo, hi = getattr(spec.bounds, key)
+        if not lo <= 0.0 <= hi:
+            problems.append(f"bounds.{key}: {[lo, hi]!r} must contain 0 (the robot must be able to hold)")
+    return problems
+
+
+def resolve_spec(data: Any, source: str = "spec") -> Spec:
+    """Validate a parsed spec (a mapping, or None for all defaults) and fill in the defaults."""
+    problems: list[str] = []
+    spec = _resolve_section(Spec, data, "", problems)
+    if not problems:
+        problems = _cross_checks(spec)
+    if problems:
+        raise SpecError(problems, source)
+    return spec
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """yaml.SafeLoader that refuses duplicate keys instead of silently keeping the last one."""
+
+
+def _construct_unique_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False) -> Any:
+    seen: dict[Any, int] = {}
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            raise SpecError(
+                [f"{key}: duplicate key (lines {seen[key] + 1} and {key_node.start_mark.line + 1}): keep one"]
+            )
+        seen[key] = key_node.start_mark.line
+    return loader.construct_mapping(node, deep=deep)
+
+
+# YAML 1.1 (PyYAML) reads 1e-6 as a string; specs are written by people who expect a number.
+_UniqueKeyLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"),
+)
+_UniqueKeyLoader.add_constructor(
+    yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG,
+    _construct_unique_mapping,
+)
+
+
+def parse_spec_text(text: str, source: str = "spec") -> Spec:
+    """Parse YAML text (safe loader, duplicate keys refused) and resolve it."""
+    try:
+        data = yaml.load(text, Loader=_UniqueKeyLoader)
+    except SpecError as err:
+        raise SpecError(err.problems, source) from None
+    except yaml.YAMLError as err:
+        raise SpecError([f"not valid YAML: {err}"], source) from None
+    return resolve_spec(data, source)
+
+
+def load_spec(path: str | Path | None) -> Spec:
+    """The spec in the YAML file at ``path``, or the built-in default spec when ``path`` is None."""
+    if path is None:
+        return Spec()
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as err:
+        raise SpecError([f"cannot read {p}: {err.strerror}"], str(p)) from None
+    return parse_spec_text(text, str(p))
+
+
+def describe_schema() -> list[tuple[str, str, Any]]:
+    """(key path, doc, default) for every leaf key: for the CLI's help and the docs."""
+    rows: list[tuple[str, str, Any]] = []
+
+    def walk(cls: type, prefix: str) -> None:
+        for f in dataclasses.fields(cls):
+            path = f"{prefix}{f.name}"
+            rule = f.metadata.get("rule")
+            if rule is None:
+                walk(cast(type, f.default_factory), f"{path}.")
+            else:
+                rows.append((path, rule.doc, _plain(f.default)))
+
+    walk(Spec, "")
+    return rows

@@ -1,0 +1,154 @@
+"""cffi bindings of a generated solver: load the shared library and call it on numpy arrays.
+
+ABI mode (dlopen) with the declarations the generator wrote next to the C code, so loading needs
+no compiler beyond the one that built the library. The library's spec hash and sizes are checked
+against the package's manifest before anything is called.
+"""
+
+from __future__ import annotations
+
+import json
+from collections import namedtuple
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import cffi
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from humanmpc.codegen.build import build, is_stale
+
+FloatArray = NDArray[np.float64]
+
+
+class LoadError(RuntimeError):
+    """A generated solver folder that cannot be loaded (missing, stale, or not matching its library)."""
+
+
+@dataclass(frozen=True)
+class Dims:
+    nx: int
+    nu: int
+    N: int
+    nh: int
+    ng: int
+    dt: float
+    T: float
+
+
+def _as_input(fn: str, port: str, value: ArrayLike, shape: tuple[int, ...]) -> FloatArray:
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.shape != shape and not (arr.size == 1 and shape == ()):
+        want = "a scalar" if shape == () else f"shape {shape}"
+        raise ValueError(f"{fn}(): input '{port}' must be {want}, got shape {arr.shape}")
+    # Column-major buffer for matrices, as the C code reads them.
+    return np.ascontiguousarray(arr.reshape(shape).T if arr.ndim == 2 else arr.reshape(-1))
+
+
+class ModelFunction:
+    """One generated model function, callable on numpy arrays; returns a named tuple of outputs."""
+
+    def __init__(self, ffi: cffi.FFI, cfunc: Callable[..., int], meta: dict[str, Any]) -> None:
+        self._ffi = ffi
+        self._cfunc = cfunc
+        self.name: str = meta["name"]
+        self.__doc__ = meta["doc"]
+        self.inputs: list[tuple[str, tuple[int, ...]]] = [
+            (n, () if (r, c) == (1, 1) else (r,) if c == 1 else (r, c)) for n, r, c in meta["inputs"]
+        ]
+        self.outputs: list[tuple[str, tuple[int, int]]] = [(n, (r, c)) for n, r, c in meta["outputs"]]
+        self._result: Any = namedtuple(f"{self.name}_result", [n for n, _ in self.outputs])  # type: ignore[misc]
+
+    def __call__(self, *args: ArrayLike) -> Any:
+        if len(args) != len(self.inputs):
+            names = ", ".join(n for n, _ in self.inputs)
+            raise TypeError(f"{self.name}() takes {len(self.inputs)} inputs ({names}), got {len(args)}")
+        ins = [_as_input(self.name, n, a, shape) for (n, shape), a in zip(self.inputs, args, strict=True)]
+        outs = [np.empty(r * c) for _, (r, c) in self.outputs]
+        fb = self._ffi.from_buffer
+        ret = self._cfunc(*[fb("double[]", a) for a in ins], *[fb("double[]", o) for o in outs])
+        if ret != 0:
+            raise RuntimeError(f"{self.name}() returned {ret}")
+        shaped: list[float | FloatArray] = []
+        for (_, (r, c)), o in zip(self.outputs, outs, strict=True):
+            if r == 1 and c == 1:
+                shaped.append(float(o[0]))
+            elif c == 1:
+                shaped.append(o)
+            else:
+                shaped.append(o.reshape(c, r).T)  # column-major buffer -> (rows, cols) view
+        return self._result(*shaped)
+
+
+class ModelFunctions:
+    """The model functions of a solver, as attributes: ``solver.model.dynamics(x, u)``."""
+
+    def __init__(self, functions: dict[str, ModelFunction]) -> None:
+        self._functions = functions
+        for name, fn in functions.items():
+            setattr(self, name, fn)
+
+    def __iter__(self) -> Iterator[ModelFunction]:
+        return iter(self._functions.values())
+
+    def __repr__(self) -> str:
+        return f"ModelFunctions({', '.join(self._functions)})"
+
+
+class Solver:
+    """A loaded generated solver. For now it exposes its dimensions, parameters and model functions."""
+
+    def __init__(self, solver_dir: Path, manifest: dict[str, Any], ffi: cffi.FFI, lib: Any) -> None:
+        self.path = solver_dir
+        self.name: str = manifest["name"]
+        self.spec_hash: str = manifest["spec_hash"]
+        d = manifest["dims"]
+        self.dims = Dims(nx=d["nx"], nu=d["nu"], N=d["N"], nh=d["nh"], ng=d["ng"], dt=d["dt"], T=d["T"])
+        self._ffi = ffi
+        self._lib = lib
+        self.model = ModelFunctions(
+            {f["name"]: ModelFunction(ffi, getattr(lib, f"{self.name}_{f['name']}"), f) for f in manifest["functions"]}
+        )
+
+    def default_params(self) -> dict[str, Any]:
+        """The runtime parameters with the spec's values, as Python numbers and tuples."""
+        p = self._ffi.new(f"{self.name}_params *")
+        getattr(self._lib, f"{self.name}_params_default")(p)
+        out: dict[str, Any] = {}
+        for field, ftype in self._ffi.typeof(p[0]).fields:
+            value = getattr(p, field)
+            out[field] = tuple(value) if ftype.type.kind == "array" else value
+        return out
+
+    def __repr__(self) -> str:
+        d = self.dims
+        return f"<humanmpc.Solver {self.name!r} N={d.N} nh={d.nh} dt={d.dt:g} from {self.path}>"
+
+
+def load(solver_dir: str | Path, *, build_if_needed: bool = True) -> Solver:
+    """Load the generated solver in ``solver_dir`` (compiling it first when its library is stale)."""
+    d = Path(solver_dir).resolve()
+    manifest_path = d / "manifest.json"
+    if not manifest_path.is_file():
+        raise LoadError(f"{d} is not a generated humanmpc solver (no manifest.json); run `humanmpc-gen generate`")
+    manifest = json.loads(manifest_path.read_text())
+    name = manifest["name"]
+    if is_stale(d):
+        if not build_if_needed:
+            raise LoadError(f"{d}: the library is missing or older than its sources; run `humanmpc-gen build {d}`")
+        build(d)
+    ffi = cffi.FFI()
+    ffi.cdef((d / f"{name}_cffi.h").read_text())
+    lib = ffi.dlopen(str(d / manifest["library"]))
+    got_hash = ffi.string(getattr(lib, f"{name}_spec_hash")()).decode()
+    if got_hash != manifest["spec_hash"]:
+        raise LoadError(f"{d}: the library was built from spec {got_hash[:12]}, the folder holds "
+                        f"{manifest['spec_hash'][:12]}; rebuild it")
+    dims = ffi.new("int[5]")
+    getattr(lib, f"{name}_dims")(dims + 0, dims + 1, dims + 2, dims + 3, dims + 4)
+    m = manifest["dims"]
+    if list(dims) != [m["nx"], m["nu"], m["N"], m["nh"], m["ng"]]:
+        raise LoadError(f"{d}: library sizes {list(dims)} do not match the manifest")
+    return Solver(d, manifest, ffi, lib)

@@ -1,0 +1,48 @@
+"""Shared fixtures: generated and built solvers, reused across the session (generation + build take seconds)."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+import humanmpc
+from humanmpc.codegen.build import build
+from humanmpc.codegen.generate import generate
+from humanmpc.codegen.spec import Spec, resolve_spec
+
+QUIET: Callable[[str], None] = lambda _msg: None  # noqa: E731
+
+
+def make_solver(root: Path, data: dict | None = None, *, built: bool = True) -> Path:
+    """Generate (and build) the solver of a spec given as a plain mapping into root/<name>."""
+    spec = resolve_spec(data or {})
+    out = generate(spec, root / spec.name, force=True, log=QUIET)
+    if built:
+        build(out, log=QUIET)
+    return out
+
+
+@pytest.fixture(scope="session")
+def paper_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The built-in default spec (the paper's values), generated and built."""
+    return make_solver(tmp_path_factory.mktemp("paper"))
+
+
+@pytest.fixture(scope="session")
+def paper(paper_dir: Path) -> humanmpc.Solver:
+    return humanmpc.load(paper_dir)
+
+
+@pytest.fixture(scope="session")
+def default_spec() -> Spec:
+    return Spec()
+
+
+def require_tool(name: str) -> str:
+    path = shutil.which(name)
+    if path is None:
+        pytest.fail(f"{name} is not installed: `make test` installs it (see APT_PACKAGES in the Makefile)")
+    return path

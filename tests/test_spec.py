@@ -1,0 +1,160 @@
+"""The spec: paper defaults, every malformed spec rejected with the key named, nothing written."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from humanmpc.codegen import cli
+from humanmpc.codegen.spec import Spec, SpecError, describe_schema, parse_spec_text, resolve_spec
+
+
+def test_defaults_are_the_papers_values() -> None:
+    s = Spec()
+    assert s.name == "paper"
+    assert (s.horizon.T, s.horizon.N) == (5.0, 50)
+    assert s.weights.goal == (0.5, 0.5, 0.0, 250.0)
+    assert s.weights.goal_terminal == (40.0, 40.0, 2.0, 0.0)
+    assert s.weights.control == (0.0, 0.0)
+    assert (s.collision_cost.q, s.collision_cost.d_th, s.collision_cost.kappa) == (2.0, 1.0, 5.0)
+    assert (s.humans.d_h, s.obstacle.d_s) == (0.5, 0.5)
+    assert math.isclose(s.dt, 0.1)
+
+
+def test_empty_file_and_empty_mapping_give_the_defaults() -> None:
+    assert parse_spec_text("") == Spec()
+    assert parse_spec_text("{}") == Spec()
+
+
+def test_partial_spec_keeps_other_defaults() -> None:
+    s = parse_spec_text("humans: {max: 30}\nhorizon: {N: 20}\n")
+    assert s.humans.max == 30 and s.humans.d_h == 0.5
+    assert s.horizon.N == 20 and s.horizon.T == 5.0
+
+
+def test_exponent_notation_without_dot_is_a_number() -> None:
+    assert parse_spec_text("solver: {qp_tol: 1e-8}").solver.qp_tol == 1e-8
+
+
+def test_resolved_spec_round_trips_through_yaml() -> None:
+    s = parse_spec_text("name: robot_a\nhumans: {max: 3}\nweights: {control: [0.1, 0.2]}")
+    again = parse_spec_text(s.to_yaml())
+    assert again == s and again.digest() == s.digest()
+
+
+def test_digest_changes_with_any_value() -> None:
+    assert Spec().digest() != parse_spec_text("obstacle: {d_s: 0.6}").digest()
+
+
+def test_every_key_is_documented_with_its_default() -> None:
+    rows = describe_schema()
+    keys = {k for k, _, _ in rows}
+    assert {"name", "horizon.T", "humans.max", "weights.goal", "monitor.deadline_ms"} <= keys
+    assert all(doc for _, doc, _ in rows)
+
+
+# (spec text, key path that the error must name, a fragment of the rule)
+MALFORMED = [
+    ("horizon: {n: 50}", "horizon.n", "did you mean 'N'"),
+    ("wieghts: {}", "wieghts", "did you mean 'weights'"),
+    ("horizon: {N: 0}", "horizon.N", ">= 1"),
+    ("horizon: {N: -3}", "horizon.N", ">= 1"),
+    ("horizon: {N: 50.5}", "horizon.N", "integer"),
+    ("horizon: {N: true}", "horizon.N", "integer"),
+    ("horizon: {T: 0}", "horizon.T", "> 0"),
+    ("horizon: {T: .nan}", "horizon.T", "finite"),
+    ("horizon: {T: .inf}", "horizon.T", "finite"),
+    ("horizon: {T: '5.0'}", "horizon.T", "number"),
+    ("horizon: 5", "horizon", "mapping"),
+    ("weights: {goal: [1, 2, -3, 4]}", "weights.goal[2]", ">= 0"),
+    ("weights: {goal: [1, 2, 3]}", "weights.goal", "exactly 4"),
+    ("weights: {control: 1.0}", "weights.control", "list"),
+    ("weights: {goal_terminal: [1, 2, .nan, 4]}", "weights.goal_terminal[2]", "finite"),
+    ("name: 'x; system(\"rm -rf /\")'", "name", "C identifier"),
+    ("name: 'paper */ int evil; /*'", "name", "C identifier"),
+    ("name: '3d'", "name", "C identifier"),
+    ("name: 'int'", "name", "reserved"),
+    ("name: 'while'", "name", "reserved"),
+    ("name: 'hm'", "name", "reserved"),
+    ("name: 42", "name", "string"),
+    ("name: " + "a" * 40, "name", "too long"),
+    ("bounds: {v: [1.0, 0.0]}", "bounds.v", "lower bound must be < upper"),
+    ("bounds: {a: [1.0, 1.0]}", "bounds.a", "lower bound must be < upper"),
+    ("bounds: {omega: [0.5]}", "bounds.omega", "interval"),
+    ("bounds: {v: [0.2, 1.0]}", "bounds.v", "standstill"),
+    ("collision_cost: {kappa: 0}", "collision_cost.kappa", "> 0"),
+    ("collision_cost: {q: -2}", "collision_cost.q", ">= 0"),
+    ("humans: {d_h: -0.1}", "humans.d_h", ">= 0"),
+    ("humans: {max: -1}", "humans.max", ">= 0"),
+    ("humans: {max: 100000}", "humans.max", "<= 200"),
+    ("obstacle: {slack_l1: -1}", "obstacle.slack_l1", ">= 0"),
+    ("integrator: {method: euler}", "integrator.method", "one of rk4"),
+    ("integrator: {steps: 0}", "integrator.steps", ">= 1"),
+    ("solver: {qp_tol: 0}", "solver.qp_tol", "> 0"),
+    ("monitor: {deadline_ms: -5}", "monitor.deadline_ms", "> 0"),
+    ("name: a\nname: b", "name", "duplicate key"),
+    ("[1, 2, 3]", "spec", "mapping"),
+    ("horizon: {N: [50", "", "not valid YAML"),
+]
+
+
+@pytest.mark.parametrize(("text", "key", "rule"), MALFORMED, ids=[m[1] or "yaml" for m in MALFORMED])
+def test_malformed_spec_is_rejected_naming_key_and_rule(text: str, key: str, rule: str) -> None:
+    with pytest.raises(SpecError) as info:
+        parse_spec_text(text)
+    message = str(info.value)
+    assert rule in message
+    if key:
+        assert any(p.startswith(f"{key}:") for p in info.value.problems), message
+
+
+@pytest.mark.parametrize(("text", "key", "rule"), MALFORMED, ids=[m[1] or "yaml" for m in MALFORMED])
+def test_generate_with_malformed_spec_fails_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, key: str, rule: str
+) -> None:
+    spec_file = tmp_path / "bad.yaml"
+    spec_file.write_text(text)
+    out = tmp_path / "out" / "solver"
+    assert cli.main(["generate", str(spec_file), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert rule in err and (not key or key in err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.yaml"]
+
+
+def test_all_problems_are_reported_at_once() -> None:
+    with pytest.raises(SpecError) as info:
+        parse_spec_text("horizon: {N: 0, T: -1}\nweights: {goal: [1, -1, 1, 1]}\nnam: x")
+    assert len(info.value.problems) == 4
+
+
+def test_spec_built_in_code_is_validated_again_before_generation(tmp_path: Path) -> None:
+    from humanmpc.codegen.generate import generate
+
+    bad = Spec(name='x"; int y; /*')
+    with pytest.raises(SpecError, match="C identifier"):
+        generate(bad, tmp_path / "x")
+    assert list(tmp_path.iterdir()) == []
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(
+    n=st.integers(1, 200),
+    nh=st.integers(0, 40),
+    t=st.floats(0.1, 30.0),
+    w=st.lists(st.floats(0.0, 1e3), min_size=4, max_size=4),
+    lo=st.floats(-3.0, 0.0),
+    width=st.floats(0.01, 5.0),
+)
+def test_valid_specs_resolve_to_what_was_written(n: int, nh: int, t: float, w: list[float], lo: float,
+                                                 width: float) -> None:
+    data = {"horizon": {"N": n, "T": t}, "humans": {"max": nh}, "weights": {"goal": w},
+            "bounds": {"a": [lo, lo + width + abs(lo)]}}
+    s = resolve_spec(yaml.safe_load(yaml.safe_dump(data)))
+    assert (s.horizon.N, s.horizon.T, s.humans.max) == (n, t, nh)
+    assert s.weights.goal == tuple(w)
+    assert s.n_rows == nh + 1
