@@ -45,7 +45,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     print("  files")
     for p in sorted(d.rglob("*")):
         if p.is_file() and "build" not in p.relative_to(d).parts[:-1]:
-            print(f"    {str(p.relative_to(d)):<28} {p.stat().st_size:>9,} B")
+            print(f"    {p.relative_to(d)!s:<28} {p.stat().st_size:>9,} B")
     lib = d / str(m["library"])
     print(f"  library      {lib} ({lib.stat().st_size:,} B)" if lib.exists() else "  library      not built")
     functions = m["functions"]
