@@ -1,0 +1,178 @@
+"""Crowd simulator: humans driven by the social force model, walking through waypoints.
+
+Integration is pysocialforce's semi-implicit Euler step (``v <- cap(v + dt F)``, then
+``r <- r + dt v``) with the speed capped at ``max_speed_factor * desired_speed``. A human whose
+last waypoint is final (no loop) stops dead within ``arrival_radius`` of it, as in
+pysocialforce. A human with more waypoints switches to the next one within
+``waypoint_radius``; looping humans cycle through theirs forever (walking back and forth with
+two waypoints).
+
+The robot is an agent for the humans: pass its position and velocity to :meth:`Crowd.step`
+and it enters the human-human repulsion like any other person (it is not moved by forces).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from humanmpc.social_force import (
+    SocialForceParams,
+    desired_force,
+    group_forces,
+    normalize,
+    obstacle_force,
+    obstacle_force_samples,
+    social_force,
+)
+from humanmpc.world import World
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class CrowdSpec:
+    """Initial state and intentions of k humans.
+
+    ``waypoints[i]`` is an (W_i, 2) array of goals visited in order; ``loop[i]`` makes human i
+    cycle through them. ``groups`` lists the member indices of each group (disjoint).
+    """
+
+    positions: FloatArray
+    velocities: FloatArray
+    waypoints: tuple[FloatArray, ...]
+    desired_speeds: FloatArray
+    loop: NDArray[np.bool_]
+    groups: tuple[tuple[int, ...], ...] = ()
+
+    def __post_init__(self) -> None:
+        k = self.positions.shape[0]
+        if self.positions.shape != (k, 2) or self.velocities.shape != (k, 2):
+            raise ValueError("CrowdSpec positions and velocities must both have shape (k, 2)")
+        if len(self.waypoints) != k or any(w.ndim != 2 or w.shape[1] != 2 or len(w) == 0 for w in self.waypoints):
+            raise ValueError("CrowdSpec needs one non-empty (W, 2) waypoint array per human")
+        if self.desired_speeds.shape != (k,) or self.loop.shape != (k,):
+            raise ValueError("CrowdSpec desired_speeds and loop must have shape (k,)")
+        if np.any(self.desired_speeds < 0) or not np.all(np.isfinite(self.desired_speeds)):
+            raise ValueError("CrowdSpec desired_speeds must be finite and >= 0")
+        seen: set[int] = set()
+        for g in self.groups:
+            for i in g:
+                if not 0 <= i < k or i in seen:
+                    raise ValueError(f"CrowdSpec groups must be disjoint indices in [0, {k}), got {self.groups}")
+                seen.add(i)
+
+    @property
+    def size(self) -> int:
+        return int(self.positions.shape[0])
+
+    @staticmethod
+    def build(
+        positions: ArrayLike,
+        waypoints: Sequence[ArrayLike],
+        desired_speeds: ArrayLike | float,
+        *,
+        velocities: ArrayLike | None = None,
+        loop: ArrayLike | bool = False,
+        groups: Sequence[Sequence[int]] = (),
+    ) -> CrowdSpec:
+        """Build a spec from plain sequences (velocities default to zero)."""
+        pos = np.asarray(positions, dtype=float).reshape(-1, 2)
+        k = pos.shape[0]
+        vel = np.zeros((k, 2)) if velocities is None else np.asarray(velocities, dtype=float).reshape(k, 2)
+        wps = tuple(np.asarray(w, dtype=float).reshape(-1, 2) for w in waypoints)
+        speeds = np.broadcast_to(np.asarray(desired_speeds, dtype=float), (k,)).copy()
+        loops = np.broadcast_to(np.asarray(loop, dtype=bool), (k,)).copy()
+        return CrowdSpec(pos, vel, wps, speeds, loops, tuple(tuple(int(i) for i in g) for g in groups))
+
+
+@dataclass
+class Crowd:
+    """The running simulation of a :class:`CrowdSpec` in a :class:`World`."""
+
+    spec: CrowdSpec
+    world: World = field(default_factory=World)
+    params: SocialForceParams = field(default_factory=SocialForceParams)
+    waypoint_radius: float = 0.5
+    time: float = field(init=False, default=0.0)
+
+    def __post_init__(self) -> None:
+        k = self.spec.size
+        self._pos = self.spec.positions.copy()
+        self._vel = self.spec.velocities.copy()
+        n_wp = np.array([len(w) for w in self.spec.waypoints], dtype=np.int64)
+        self._n_wp = n_wp
+        self._wp = np.zeros((k, int(n_wp.max()) if k else 1, 2))
+        for i, w in enumerate(self.spec.waypoints):
+            self._wp[i, : len(w)] = w
+        self._wp_idx = np.zeros(k, dtype=np.int64)
+        self._group_id = np.full(k, -1, dtype=np.int64)
+        for g_index, members in enumerate(self.spec.groups):
+            self._group_id[list(members)] = g_index
+        self._obstacle_samples = self.world.boundary_samples(self.params.obstacle_resolution)
+        self._max_speed = self.params.max_speed_factor * self.spec.desired_speeds
+
+    @property
+    def size(self) -> int:
+        return self.spec.size
+
+    @property
+    def positions(self) -> FloatArray:
+        return self._pos.copy()
+
+    @property
+    def velocities(self) -> FloatArray:
+        return self._vel.copy()
+
+    @property
+    def goals(self) -> FloatArray:
+        """The waypoint each human currently walks to, (k, 2)."""
+        return self._wp[np.arange(self.size), self._wp_idx].copy()
+
+    def _advance_waypoints(self) -> None:
+        goals = self.goals
+        reached = np.linalg.norm(goals - self._pos, axis=1) < self.waypoint_radius
+        has_next = self._wp_idx + 1 < self._n_wp
+        move_on = reached & (has_next | self.spec.loop)
+        self._wp_idx = np.where(move_on, (self._wp_idx + 1) % self._n_wp, self._wp_idx)
+
+    def forces(self, robot_position: ArrayLike | None = None, robot_velocity: ArrayLike | None = None) -> FloatArray:
+        """Total social force on every human, (k, 2)."""
+        p = self.params
+        goals = self.goals
+        others_pos, others_vel = self._pos, self._vel
+        if robot_position is not None:
+            rv = np.zeros(2) if robot_velocity is None else np.asarray(robot_velocity, dtype=float).reshape(2)
+            others_pos = np.vstack([self._pos, np.asarray(robot_position, dtype=float).reshape(1, 2)])
+            others_vel = np.vstack([self._vel, rv.reshape(1, 2)])
+        f = desired_force(self._pos, self._vel, goals, self.spec.desired_speeds, p)
+        f += social_force(self._pos, self._vel, others_pos, others_vel, np.arange(self.size), p)
+        if p.pysocialforce_compat:
+            f += obstacle_force_samples(self._pos, self._obstacle_samples, p)
+        elif not self.world.is_empty:
+            signed, nearest = self.world.per_obstacle(self._pos)
+            f += obstacle_force(self._pos, signed, nearest, p)
+        f += group_forces(self._pos, goals, self._group_id, p)
+        return f
+
+    def step(self, robot_position: ArrayLike | None = None, robot_velocity: ArrayLike | None = None) -> None:
+        """Advance the crowd by one ``params.dt``; the robot (if given) repels the humans."""
+        if self.size == 0:
+            self.time += self.params.dt
+            return
+        self._advance_waypoints()
+        force = self.forces(robot_position, robot_velocity)
+        if not np.all(np.isfinite(force)):
+            raise FloatingPointError("social force model produced a non-finite force; check the crowd state")
+        vel = self._vel + self.params.dt * force
+        direction, speed = normalize(vel)
+        vel = direction * np.minimum(speed, self._max_speed)[:, None]
+        final = ~(self._wp_idx + 1 < self._n_wp) & ~self.spec.loop
+        arrived = final & (np.linalg.norm(self.goals - self._pos, axis=1) < self.params.arrival_radius)
+        vel[arrived] = 0.0
+        self._pos = self._pos + self.params.dt * vel
+        self._vel = vel
+        self.time += self.params.dt

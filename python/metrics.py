@@ -1,0 +1,162 @@
+"""Social-navigation metrics of one episode.
+
+Definitions (distances to humans are centre-to-centre, robot centre to human centre):
+
+* collision with a human: centre distance < robot radius + human radius; with an obstacle:
+  signed distance of the robot centre < robot radius. A collision *event* is an entry into
+  contact (a rising edge over the logged samples; contact at the first sample counts);
+* success: the goal was reached within the time limit with no collision event at all;
+* time inside a distance band: ``dt`` times the number of control intervals whose starting
+  sample has the nearest human in that band; ``intimate`` is d < 0.45 m and ``personal`` is
+  0.45 m <= d < 1.2 m (Hall's proxemic zones), ``within_dth`` is d < d_th (1.0 m);
+* protective stops: events (rising edges of the planner's ``stop`` flag), counted per reason
+  of the first step of each event, and the total time spent stopping;
+* path irregularity (SocNavBench, after Guzzi et al. 2013): the sum over the logged samples of
+  the absolute angle between the robot's heading and the direction to the goal, divided by
+  the path length (rad/m; it depends on the sampling period, 0.1 s here; a sample exactly on
+  the goal, where the direction is undefined, is skipped);
+* jerk (SocNavBench "average jerk"): the mean norm of the third finite difference of the
+  robot positions divided by dt^3 (m/s^3);
+* planner time: mean, 99th percentile (linear interpolation) and maximum of the per-step
+  planner time in ms.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from humanmpc.episode import EpisodeLog
+
+FloatArray = NDArray[np.float64]
+
+INTIMATE = 0.45
+PERSONAL = 1.2
+D_TH = 1.0
+
+
+@dataclass(frozen=True)
+class EpisodeMetrics:
+    success: bool
+    reached_goal: bool
+    timeout: bool
+    collisions: int
+    human_collisions: int
+    obstacle_collisions: int
+    collision_time: float
+    time_to_goal: float
+    path_length: float
+    min_human_distance: float
+    time_within_dth: float
+    time_intimate: float
+    time_personal: float
+    protective_stops: int
+    stop_time: float
+    path_irregularity: float
+    mean_jerk: float
+    planner_ms_mean: float
+    planner_ms_p99: float
+    planner_ms_max: float
+    stops_by_reason: dict[str, int] = field(default_factory=dict)
+
+    def as_row(self) -> dict[str, float | int | bool | str]:
+        """Flat mapping for tables (stops_by_reason as ``stops[reason]`` columns)."""
+        row: dict[str, float | int | bool | str] = {k: v for k, v in asdict(self).items() if k != "stops_by_reason"}
+        for reason, count in sorted(self.stops_by_reason.items()):
+            row[f"stops[{reason}]"] = count
+        return row
+
+
+def rising_edges(flags: NDArray[np.bool_]) -> NDArray[np.int64]:
+    """Indices where a boolean series switches on (index 0 if it starts on)."""
+    f = np.asarray(flags, dtype=bool)
+    if f.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    prev = np.concatenate([[False], f[:-1]])
+    return np.nonzero(f & ~prev)[0]
+
+
+def path_length(positions: FloatArray) -> float:
+    return float(np.sum(np.linalg.norm(np.diff(positions, axis=0), axis=1)))
+
+
+def human_distances(robot_xy: FloatArray, humans: FloatArray) -> FloatArray:
+    """Distance from the robot to the nearest human at every sample (inf without humans)."""
+    if humans.shape[1] == 0:
+        return np.full(robot_xy.shape[0], np.inf)
+    return np.linalg.norm(humans - robot_xy[:, None, :], axis=-1).min(axis=1)
+
+
+def time_in_band(distances: FloatArray, lo: float, hi: float, dt: float) -> float:
+    """dt times the intervals whose starting sample has lo <= d < hi (last sample excluded)."""
+    d = distances[:-1]
+    return float(dt * np.count_nonzero((d >= lo) & (d < hi)))
+
+
+def path_irregularity(states: FloatArray, goal_xy: FloatArray) -> float:
+    to_goal = goal_xy[None, :] - states[:, :2]
+    dist = np.linalg.norm(to_goal, axis=1)
+    defined = dist > 1e-6  # on the goal itself the direction to it is undefined
+    heading = np.stack([np.cos(states[:, 2]), np.sin(states[:, 2])], axis=1)
+    cos = np.sum(to_goal * heading, axis=1)[defined] / dist[defined]
+    total = float(np.sum(np.arccos(np.clip(cos, -1.0, 1.0))))
+    return total / (path_length(states[:, :2]) + 1e-10)
+
+
+def mean_jerk(positions: FloatArray, dt: float) -> float:
+    if positions.shape[0] < 4:
+        return 0.0
+    jerk = np.diff(positions, n=3, axis=0) / dt**3
+    return float(np.mean(np.linalg.norm(jerk, axis=1)))
+
+
+def timing_stats(solve_ms: FloatArray) -> tuple[float, float, float]:
+    if solve_ms.size == 0:
+        return (float("nan"),) * 3
+    return float(np.mean(solve_ms)), float(np.percentile(solve_ms, 99)), float(np.max(solve_ms))
+
+
+def stop_events(stops: NDArray[np.bool_], reasons: Sequence[str | None]) -> dict[str, int]:
+    return dict(Counter(str(reasons[i] or "unspecified") for i in rising_edges(stops)))
+
+
+def compute_metrics(log: EpisodeLog) -> EpisodeMetrics:
+    """All metrics of one episode."""
+    xy = log.states[:, :2]
+    robot = log.robot
+    d_h = human_distances(xy, log.humans)
+    human_contact = d_h < robot.radius + robot.human_radius
+    obstacle_contact = log.world.signed_distance(xy) < robot.radius
+    contact = human_contact | obstacle_contact
+    h_events = len(rising_edges(human_contact))
+    o_events = len(rising_edges(obstacle_contact))
+    n_events = len(rising_edges(contact))
+    mean_ms, p99_ms, max_ms = timing_stats(log.solve_ms)
+    reasons = stop_events(log.stops, log.reasons)
+    return EpisodeMetrics(
+        success=bool(log.reached_goal and n_events == 0),
+        reached_goal=bool(log.reached_goal),
+        timeout=log.ended_by == "time_limit",
+        collisions=n_events,
+        human_collisions=h_events,
+        obstacle_collisions=o_events,
+        collision_time=float(log.dt * np.count_nonzero(contact[:-1])),
+        time_to_goal=float(log.times[-1]) if log.reached_goal else float("nan"),
+        path_length=path_length(xy),
+        min_human_distance=float(np.min(d_h)),
+        time_within_dth=time_in_band(d_h, 0.0, D_TH, log.dt),
+        time_intimate=time_in_band(d_h, 0.0, INTIMATE, log.dt),
+        time_personal=time_in_band(d_h, INTIMATE, PERSONAL, log.dt),
+        protective_stops=int(sum(reasons.values())),
+        stop_time=float(log.dt * np.count_nonzero(log.stops)),
+        path_irregularity=path_irregularity(log.states, log.goal[:2]),
+        mean_jerk=mean_jerk(xy, log.dt),
+        planner_ms_mean=mean_ms,
+        planner_ms_p99=p99_ms,
+        planner_ms_max=max_ms,
+        stops_by_reason=reasons,
+    )

@@ -1,0 +1,43 @@
+"""Planners by name: a factory per name, so the CLI and the evaluation can build them.
+
+``register_planner("mpc", factory)`` adds a planner; the factory takes no argument and returns
+a fresh :class:`~humanmpc.planner.Planner`. The DWB baseline is registered as ``"dwb"``.
+Evaluation workers are forked from the registering process, so registrations made before an
+evaluation starts are visible in the workers.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from humanmpc.dwb import DWBPlanner
+from humanmpc.planner import Planner
+
+PlannerFactory = Callable[[], Planner]
+
+_PLANNERS: dict[str, PlannerFactory] = {}
+
+
+def register_planner(name: str, factory: PlannerFactory, *, replace: bool = False) -> None:
+    """Make ``factory`` available as ``name``; re-registering needs ``replace=True``."""
+    if not name or not name.replace("_", "").replace("-", "").isalnum():
+        raise ValueError(f"planner names are non-empty words (letters, digits, '-', '_'), got {name!r}")
+    if name in _PLANNERS and not replace:
+        raise ValueError(f"a planner named {name!r} is already registered (pass replace=True to override)")
+    _PLANNERS[name] = factory
+
+
+def planner_names() -> list[str]:
+    return sorted(_PLANNERS)
+
+
+def make_planner(name: str) -> Planner:
+    """A fresh planner for ``name``; ``ValueError`` listing the registered names otherwise."""
+    try:
+        factory = _PLANNERS[name]
+    except KeyError:
+        raise ValueError(f"unknown planner {name!r}; valid planners: {', '.join(planner_names())}") from None
+    return factory()
+
+
+register_planner("dwb", DWBPlanner)

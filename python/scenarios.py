@@ -1,0 +1,200 @@
+"""Seeded, reproducible evaluation scenarios.
+
+Every scenario is a pure function of its seed (``numpy.random.default_rng(seed)``) and gives
+the world, the crowd's initial state and waypoints, the robot's start state and goal, and a
+time limit. Humans start walking at their desired speed towards their first waypoint and
+walk back and forth between their waypoints for the whole episode (so the scene stays busy
+however long the robot needs). Desired walking speeds are drawn from U(0.9, 1.3) m/s around
+the 1.1-1.3 m/s usually measured for people walking indoors; the social force model caps the
+speed at 1.3 times the desired one (Helbing & Molnár).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from humanmpc.crowd import CrowdSpec
+from humanmpc.world import Circle, Obstacle, Polygon, World
+
+FloatArray = NDArray[np.float64]
+
+V_REF = 0.8  # the robot's preferred cruising speed in every scenario (m/s)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """Everything an episode needs to start."""
+
+    name: str
+    seed: int
+    world: World
+    crowd: CrowdSpec
+    robot_start: FloatArray  # [px, py, theta, v]
+    goal: FloatArray  # [gx, gy, gtheta, v_ref]
+    time_limit: float
+    goal_tolerance: float = 0.3
+
+
+def _heading(a: FloatArray, b: FloatArray) -> float:
+    d = b - a
+    return float(np.arctan2(d[1], d[0]))
+
+
+def _robot(start: FloatArray, goal: FloatArray) -> tuple[FloatArray, FloatArray]:
+    th = _heading(start, goal)
+    return np.array([start[0], start[1], th, 0.0]), np.array([goal[0], goal[1], th, V_REF])
+
+
+def _walking(positions: FloatArray, first_goals: FloatArray, speeds: FloatArray) -> FloatArray:
+    d = first_goals - positions
+    return d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-9) * speeds[:, None]
+
+
+def _sample_free(
+    rng: np.random.Generator, world: World, lo: float, hi: float, clearance: float, avoid: list[FloatArray], sep: float
+) -> FloatArray:
+    for _ in range(10_000):
+        p = rng.uniform(lo, hi, 2)
+        if world.contains_free_disc(p, clearance) and all(np.linalg.norm(p - q) >= sep for q in avoid):
+            return p
+    raise RuntimeError("scenario sampling failed to place a point; the scene is too crowded for its area")
+
+
+def random_crowded_cluttered(seed: int) -> Scenario:
+    """The paper's scene: 10 humans between random start and goal points, 5 random static
+    obstacles (discs and rotated boxes), robot start and goal on opposite sides of the area."""
+    rng = np.random.default_rng(seed)
+    half = 7.0
+    phi = rng.uniform(-np.pi, np.pi)
+    direction = np.array([np.cos(phi), np.sin(phi)])
+    r_start, r_goal = -5.5 * direction, 5.5 * direction
+    obstacles: list[Obstacle] = []
+    centres: list[FloatArray] = []
+    while len(obstacles) < 5:
+        c = rng.uniform(-4.5, 4.5, 2)
+        if min(np.linalg.norm(c - r_start), np.linalg.norm(c - r_goal)) < 2.0:
+            continue
+        if any(np.linalg.norm(c - q) < 2.2 for q in centres):
+            continue
+        if rng.uniform() < 0.5:
+            obstacles.append(Circle((float(c[0]), float(c[1])), float(rng.uniform(0.3, 0.7))))
+        else:
+            w, h = rng.uniform(0.5, 1.5), rng.uniform(0.3, 1.0)
+            obstacles.append(Polygon.rectangle((float(c[0]), float(c[1])), w, h, float(rng.uniform(0, np.pi))))
+        centres.append(c)
+    world = World(tuple(obstacles), (-half, half, -half, half))
+    starts: list[FloatArray] = []
+    goals: list[FloatArray] = []
+    for _ in range(10):
+        s = _sample_free(rng, world, -6.0, 6.0, 0.5, [*starts, r_start], 1.2)
+        g = s
+        while np.linalg.norm(g - s) < 5.0:
+            g = _sample_free(rng, world, -6.0, 6.0, 0.5, [], 0.0)
+        starts.append(s)
+        goals.append(g)
+    pos, gl = np.array(starts), np.array(goals)
+    speeds = rng.uniform(0.9, 1.3, 10)
+    crowd = CrowdSpec.build(
+        pos, [np.stack([g, s]) for s, g in zip(pos, gl, strict=True)], speeds,
+        velocities=_walking(pos, gl, speeds), loop=True,
+    )
+    x0, goal = _robot(r_start, r_goal)
+    return Scenario("random_crowded_cluttered", seed, world, crowd, x0, goal, time_limit=60.0)
+
+
+def crossing_group(seed: int) -> Scenario:
+    """A group of 9 (3 x 3 formation) walking back and forth across the robot's way."""
+    rng = np.random.default_rng(seed)
+    world = World((), (-8.0, 8.0, -8.0, 8.0))
+    r_start, r_goal = np.array([0.0, -6.0]), np.array([0.0, 6.0])
+    spacing = 0.8
+    offsets = np.array([[i * spacing, j * spacing] for i in (-1, 0, 1) for j in (-1, 0, 1)])
+    offsets += rng.normal(0.0, 0.05, offsets.shape)
+    y0 = rng.uniform(-1.0, 1.0)
+    x0 = rng.uniform(-6.5, -3.0)
+    sign = 1.0 if rng.uniform() < 0.5 else -1.0
+    centre = np.array([sign * x0, y0])
+    pos = centre + offsets
+    far = np.array([-sign * 7.0, y0]) + offsets
+    near = np.array([sign * 7.0, y0]) + offsets
+    speed = rng.uniform(0.9, 1.1)
+    speeds = speed + rng.uniform(-0.05, 0.05, 9)
+    crowd = CrowdSpec.build(
+        pos, [np.stack([f, n]) for f, n in zip(far, near, strict=True)], speeds,
+        velocities=_walking(pos, far, speeds), loop=True, groups=[tuple(range(9))],
+    )
+    x_start, goal = _robot(r_start, r_goal)
+    return Scenario("crossing_group", seed, world, crowd, x_start, goal, time_limit=60.0)
+
+
+def circle_crossing(seed: int) -> Scenario:
+    """8 humans on a circle of radius 4.5 m walking to the antipodes and back; the robot
+    crosses the circle from south to north."""
+    rng = np.random.default_rng(seed)
+    world = World((), (-7.0, 7.0, -7.0, 7.0))
+    radius = 4.5
+    angles: list[float] = []
+    while len(angles) < 8:
+        a = rng.uniform(-np.pi, np.pi)
+        if min(abs(np.angle(np.exp(1j * (a - b)))) for b in (np.pi / 2, -np.pi / 2)) < 0.5:
+            continue
+        if any(abs(np.angle(np.exp(1j * (a - b)))) < 0.3 for b in angles):
+            continue
+        angles.append(a)
+    ang = np.array(angles)
+    pos = radius * np.stack([np.cos(ang), np.sin(ang)], axis=1)
+    goals = -pos + rng.normal(0.0, 0.2, pos.shape)
+    speeds = rng.uniform(0.9, 1.3, 8)
+    crowd = CrowdSpec.build(
+        pos, [np.stack([g, s]) for s, g in zip(pos, goals, strict=True)], speeds,
+        velocities=_walking(pos, goals, speeds), loop=True,
+    )
+    x0, goal = _robot(np.array([0.0, -radius]), np.array([0.0, radius]))
+    return Scenario("circle_crossing", seed, world, crowd, x0, goal, time_limit=40.0)
+
+
+def corridor(seed: int) -> Scenario:
+    """A 3 m wide, 20 m long corridor; 5 people walk towards the robot and back."""
+    rng = np.random.default_rng(seed)
+    width, length, wall = 3.0, 20.0, 0.2
+    walls = (
+        Polygon.rectangle((0.0, width / 2 + wall / 2), length, wall),
+        Polygon.rectangle((0.0, -width / 2 - wall / 2), length, wall),
+    )
+    world = World(walls, (-length / 2 - 0.5, length / 2 + 0.5, -width / 2 - 1.0, width / 2 + 1.0))
+    starts: list[FloatArray] = []
+    while len(starts) < 5:
+        p = np.array([rng.uniform(1.0, 9.0), rng.uniform(-0.8, 0.8)])
+        if all(np.linalg.norm(p - q) >= 1.0 for q in starts):
+            starts.append(p)
+    pos = np.array(starts)
+    far = np.stack([np.full(5, -9.5), rng.uniform(-0.8, 0.8, 5)], axis=1)
+    back = np.stack([np.full(5, 9.5), rng.uniform(-0.8, 0.8, 5)], axis=1)
+    speeds = rng.uniform(0.9, 1.3, 5)
+    crowd = CrowdSpec.build(
+        pos, [np.stack([f, b]) for f, b in zip(far, back, strict=True)], speeds,
+        velocities=_walking(pos, far, speeds), loop=True,
+    )
+    x0, goal = _robot(np.array([-8.5, 0.0]), np.array([8.5, 0.0]))
+    return Scenario("corridor", seed, world, crowd, x0, goal, time_limit=60.0)
+
+
+SCENARIOS: dict[str, Callable[[int], Scenario]] = {
+    "random_crowded_cluttered": random_crowded_cluttered,
+    "crossing_group": crossing_group,
+    "circle_crossing": circle_crossing,
+    "corridor": corridor,
+}
+
+
+def make_scenario(name: str, seed: int) -> Scenario:
+    """The scenario ``name`` for ``seed``; ``ValueError`` listing the valid names otherwise."""
+    try:
+        factory = SCENARIOS[name]
+    except KeyError:
+        raise ValueError(f"unknown scenario {name!r}; valid scenarios: {', '.join(sorted(SCENARIOS))}") from None
+    return factory(int(seed))
