@@ -11,14 +11,17 @@ GEN := $(VENV)/bin/humanmpc-gen
 STAMP := $(VENV)/.installed
 
 # Debian packages the suite needs: compilers (gcc, clang + its sanitizer/fuzzer runtime), make and
-# CMake for the generated package, binutils for nm, valgrind, Python venv support.
-APT_PACKAGES := gcc clang libclang-rt-14-dev make cmake binutils valgrind python3-venv python3-dev
+# CMake for the generated package, binutils for nm, valgrind, Python venv support, and Debian's Ipopt
+# (with the BLAS/LAPACK it links) for the C reference solver.
+APT_PACKAGES := gcc clang libclang-rt-14-dev make cmake binutils valgrind python3-venv python3-dev \
+	coinor-libipopt-dev libblas-dev liblapack-dev
 
-.PHONY: help test demo system-deps venv lint clean
+.PHONY: help test demo bench system-deps venv lint clean
 
 help:
 	@echo "make test   - set up everything on a fresh Debian machine and run the whole test suite"
 	@echo "make demo   - generate and build the solver of the built-in default spec"
+	@echo "make bench  - time the RTI in random crowds; compare with acados and Ipopt (docs/benchmarks.md)"
 	@echo "make lint   - ruff and mypy"
 
 system-deps:
@@ -50,6 +53,10 @@ demo: venv
 	$(GEN) generate -o generated/paper --force
 	$(GEN) build generated/paper
 	$(GEN) info generated/paper
+
+bench: venv
+	$(GEN) bench --out out/bench
+	$(GEN) bench --compare --compare-out out/compare
 
 lint: venv
 	$(PY) -m ruff check codegen python tests

@@ -18,9 +18,14 @@
 #define HM_NU 2
 #define HM_NP 2
 
-/* Runtime functions are private to the translation unit that includes them. */
+/* Runtime functions are private to the translation unit that includes them. A solver need not use
+ * every helper of the runtime, so unused ones must not warn. */
 #ifndef HM_FUNC
+#if defined(__GNUC__)
+#define HM_FUNC static __attribute__((unused))
+#else
 #define HM_FUNC static
+#endif
 #endif
 
 #define HM_CONCAT_(a, b) a##b

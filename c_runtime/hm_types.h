@@ -56,7 +56,7 @@ typedef struct HM_NS(ocp_qp) {
     HM_REAL Zl[HM_N + 1][HM_NG];
 } HM_NS(ocp_qp);
 
-/* ocp_qp_sol: primal and dual solution of an ocp_qp (sign conventions in ocp_qp_sol.h). */
+/* ocp_qp_sol: primal and dual solution of an ocp_qp (sign conventions in ocp_qp.h). */
 typedef struct HM_NS(ocp_qp_sol) {
     HM_REAL x[HM_N + 1][HM_NX];
     HM_REAL u[HM_N][HM_NU];
@@ -70,4 +70,101 @@ typedef struct HM_NS(ocp_qp_sol) {
     HM_REAL lam_ls[HM_N + 1][HM_NG];
 } HM_NS(ocp_qp_sol);
 
-/* @@QP_IPM_TYPES@@ : ocp_qp_ipm_arg, ocp_qp_ipm_ws, ocp_qp_ipm_stats (owned by ocp_qp_ipm) */
+/* ------------------------------------------------------------------------------------------------
+ * ocp_qp_ipm: the interior-point solver of ocp_qp (ocp_qp_ipm.h, ocp_qp_kkt.h, ocp_qp.h).
+ *
+ * The solver works on a homogeneous self-dual embedding of the QP. Its inequality rows (present
+ * bounds, general rows, s >= 0 of soft rows) are packed stage after stage into flat arrays of at
+ * most (HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG) entries, so that absent rows take neither
+ * time nor a place in the iteration; the map from rows to the QP is rebuilt by every solve.
+ * ---------------------------------------------------------------------------------------------- */
+
+/* Residuals of a primal-dual pair (ocp_qp_res_compute), infinity norms in the units of the data. */
+typedef struct HM_NS(ocp_qp_res) {
+    HM_REAL stat;    /* gradient of the Lagrangian with respect to u, x and s */
+    HM_REAL eq;      /* dynamics */
+    HM_REAL ineq;    /* largest violation of a bound, a row (hard or with its slack) or of s >= 0 */
+    HM_REAL comp;    /* largest |multiplier * constraint value| */
+    HM_REAL dual;    /* largest violation of multiplier >= 0 */
+    HM_REAL obj;     /* objective, including the constant terms of the fixed x_0 */
+} HM_NS(ocp_qp_res);
+
+/* Options of ocp_qp_ipm_solve; ocp_qp_ipm_arg_set_default gives working values. */
+typedef struct HM_NS(ocp_qp_ipm_arg) {
+    int max_iter;            /* interior-point iterations before HM_QP_MAX_ITER */
+    HM_REAL tol;             /* on the scaled primal and dual residuals and the duality gap */
+    HM_REAL tol_infeas;      /* certificate: no feasible point has ||(u, x, s)||_1 < 1 / tol_infeas */
+    HM_REAL step_frac;       /* fraction of the step to the boundary that is taken */
+    HM_REAL min_step;        /* a shorter step means no progress: HM_QP_NUMERICAL */
+    int polish;              /* 1: refine a solution on its active set (ocp_qp_ipm.h) */
+    int (*should_stop)(void *ctx);   /* polled once per iteration; nonzero ends with HM_QP_TIMEOUT */
+    void *stop_ctx;
+} HM_NS(ocp_qp_ipm_arg);
+
+/* The variables of the embedding that live in the QP's shape: per stage (u, x) (u of stage HM_N and
+ * x of stage 0 unused), slacks s[n][k] of the k-th general row if it is soft, multipliers y of the
+ * dynamics and z of the packed inequality rows. Used for the iterate, the step, the residuals and a
+ * constant solve. */
+typedef struct HM_NS(ocp_qp_ipm_vec) {
+    HM_REAL ux[HM_N + 1][HM_NU + HM_NX];
+    HM_REAL s[HM_N + 1][HM_NG];
+    HM_REAL y[HM_N][HM_NX];
+    HM_REAL z[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
+} HM_NS(ocp_qp_ipm_vec);
+
+/* All memory of a solve. Only the first block is meant for the caller. */
+typedef struct HM_NS(ocp_qp_ipm_ws) {
+    /* outcome of the last solve */
+    int status;
+    int iter;                         /* interior-point iterations done */
+    HM_NS(ocp_qp_res) res;            /* residuals of the returned solution (ocp_qp_res_compute) */
+    HM_REAL res_primal, res_dual, gap;   /* the scaled measures compared with arg->tol */
+    HM_REAL mu, tau, kappa;           /* of the last iterate */
+    int unbounded;                    /* NUMERICAL because a direction of unbounded descent was found */
+    int polished;                     /* the solution is the active-set refinement of the iterate */
+
+    /* packed inequality rows of stage n from off[n]: nb[n] bounds, nr[n] general rows, ns[n] rows
+     * s >= 0 of the soft ones among them; m rows in all */
+    int m;
+    int off[HM_N + 1];
+    int nb[HM_N + 1];
+    int nr[HM_N + 1];
+    int ns[HM_N + 1];
+    unsigned char box_comp[HM_N + 1][2 * (HM_NU + HM_NX)];   /* component of (u, x) */
+    HM_REAL box_sign[HM_N + 1][2 * (HM_NU + HM_NX)];          /* +1 upper bound, -1 lower bound */
+    unsigned char row_idx[HM_N + 1][HM_NG];   /* QP row i of the k-th general row */
+    unsigned char soft_of[HM_N + 1][HM_NG];   /* k of the j-th soft row */
+    HM_REAL D[HM_N + 1][HM_NG][HM_NP];        /* D of the k-th general row */
+    HM_REAL soft_Zl[HM_N + 1][HM_NG];         /* Zl of the j-th soft row, times cost_scale */
+    /* the data of the embedding: cost gradient q and right-hand sides b (dynamics, inequality rows),
+     * with the terms of the fixed x_0 moved into stage 0 */
+    HM_REAL q_ux[HM_N + 1][HM_NU + HM_NX];
+    HM_REAL q_s[HM_N + 1][HM_NG];
+    HM_REAL b_eq[HM_N][HM_NX];
+    HM_REAL b_ineq[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
+    HM_REAL norm_q, norm_b;
+    HM_REAL cost_scale;               /* the cost is solved scaled by this (ocp_qp_ipm.c) */
+    HM_REAL w_max;                    /* cap of the row weights (ocp_qp_ipm.c) */
+
+    /* iterate (v, t, tau, kappa), step, constant solve, residuals */
+    HM_NS(ocp_qp_ipm_vec) v, dv, v1, rv;
+    HM_REAL t[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
+    HM_REAL dt[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
+    HM_REAL dtau, dkappa, rtau;
+    HM_REAL c_ux[HM_N + 1][HM_NU + HM_NX];   /* q + 2 P v / tau, the tau row of the Newton system */
+    HM_REAL c_s[HM_N + 1][HM_NG];
+    HM_REAL ds[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];   /* complementarity target */
+    HM_REAL zinv[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];   /* 1 / z */
+    HM_REAL winv[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];   /* 1 / w */
+
+    /* Newton system (ocp_qp_kkt): row weights z / t, stage-wise eliminated soft slacks, Riccati */
+    HM_REAL w[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
+    HM_REAL soft_hinv[HM_N + 1][HM_NG];     /* of the j-th soft row: 1 / (Zl + w_row + w_slack) */
+    HM_REAL soft_e[HM_N + 1][HM_NG];        /* per solve: its slack step at a zero position step */
+    HM_REAL P[HM_N + 1][HM_NX * HM_NX];     /* cost-to-go Hessians */
+    HM_REAL p[HM_N + 1][HM_NX];             /* cost-to-go gradients, per solve */
+    HM_REAL Lr[HM_N][3];                    /* Cholesky factor of the reduced input Hessian:
+                                               1 / l00, l10, 1 / l11 */
+    HM_REAL Y[HM_N][HM_NU * HM_NX];         /* Lr^-1 (S + B' P A) */
+    HM_REAL yk[HM_N][HM_NU];                /* per solve: Lr^-1 (reduced input gradient) */
+} HM_NS(ocp_qp_ipm_ws);

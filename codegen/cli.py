@@ -58,6 +58,26 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from humanmpc.bench import markdown_table, run_bench
+
+    if args.compare:
+        from humanmpc.compare import run_compare_from_args
+
+        return run_compare_from_args(args)
+
+    try:
+        humans = [int(h) for h in args.humans.split(",")]
+    except ValueError:
+        raise SpecError([f"--humans: {args.humans!r} is not a comma-separated list of integers"], "bench") from None
+    if any(h < 0 or h > 200 for h in humans):
+        raise SpecError([f"--humans: {args.humans!r}: each count must be in 0..200"], "bench")
+    results = run_bench(load_spec(args.spec), humans, seeds=args.seeds, steps=args.steps, out_dir=args.out)
+    print(markdown_table(results), end="")
+    print(f"(written to {args.out / 'bench.json'} and {args.out / 'bench.md'})")
+    return 0
+
+
 def _cmd_keys(args: argparse.Namespace) -> int:
     width = max(len(k) for k, _, _ in describe_schema())
     for key, doc, default in describe_schema():
@@ -98,6 +118,19 @@ def make_parser() -> argparse.ArgumentParser:
                        description="Describe the generated package DIR: its spec hash, sizes, files and functions.")
     p.add_argument("dir", type=Path, help="generated solver folder")
     p.set_defaults(func=_cmd_info)
+
+    p = sub.add_parser("bench", help="time the real-time iteration in random crowds",
+                       description="Generate one solver per crowd size and time its RTI steps in seeded "
+                       "closed loops (humans at constant velocity, one obstacle near the path).")
+    p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
+    p.add_argument("--humans", default="5,10,20,30", help="crowd sizes N_h (default: 5,10,20,30)")
+    p.add_argument("--seeds", type=int, default=3, help="closed loops per crowd size (default: 3)")
+    p.add_argument("--steps", type=int, default=300, help="RTI steps per closed loop (default: 300)")
+    p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
+    from humanmpc.compare import add_compare_arguments  # the Python package depends on codegen, not back
+
+    add_compare_arguments(p)
+    p.set_defaults(func=_cmd_bench)
 
     p = sub.add_parser("keys", help="list every spec key with its default and meaning",
                        description="List every spec key with its default value and meaning.")

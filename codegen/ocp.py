@@ -115,6 +115,20 @@ class OcpModel:
             )
         )
 
+        # Curvature of the dynamics weighted by their multipliers: the part of the Lagrangian's
+        # Hessian that Gauss-Newton leaves out (the full-SQP mode uses it, convexified per stage).
+        pi = ca.SX.sym("pi", NX)
+        z = ca.vertcat(x, u)
+        hess_dyn = ca.hessian(ca.dot(pi, x_next), z)[0]
+        functions.append(
+            self._make(
+                "dynamics_hessian",
+                "Hessian of pi' x_next(x, u) with respect to (x, u), in blocks xx, ux, uu",
+                [("x", x), ("u", u), ("pi", pi)],
+                [("hess_xx", hess_dyn[:NX, :NX]), ("hess_ux", hess_dyn[NX:, :NX]), ("hess_uu", hess_dyn[NX:, NX:])],
+            )
+        )
+
         # Least-squares goal and control terms: exact (constant, PSD) Hessians.
         r_goal = x - g
         l_stage = ca.dot(w_goal * r_goal, r_goal) + ca.dot(w_control * u, u)
@@ -156,13 +170,19 @@ class OcpModel:
         dist = smooth_distance(p, c)
         grad_d = ca.gradient(dist, p)
         f_val, f_d, f_dd = potential(dist, q, d_th, kappa)
+        hess_d = ca.hessian(dist, p)[0]
         functions.append(
             self._make(
                 "cost_collision",
-                "collision cost f(d(p, h)) of one human at predicted position h, its exact gradient "
-                "and its Gauss-Newton Hessian f''(d) grad d grad d'",
+                "collision cost f(d(p, h)) of one human at predicted position h, its exact gradient, "
+                "its Gauss-Newton Hessian f''(d) grad d grad d' and its exact Hessian",
                 [("p", p), ("h", c), ("q", q), ("d_th", d_th), ("kappa", kappa)],
-                [("f", f_val), ("grad_p", f_d * grad_d), ("hess_gn_p", f_dd * (grad_d @ grad_d.T))],
+                [
+                    ("f", f_val),
+                    ("grad_p", f_d * grad_d),
+                    ("hess_gn_p", f_dd * (grad_d @ grad_d.T)),
+                    ("hess_p", f_dd * (grad_d @ grad_d.T) + f_d * hess_d),
+                ],
             )
         )
 
@@ -171,9 +191,9 @@ class OcpModel:
         functions.append(
             self._make(
                 "distance_constraint",
-                "distance row d(p, c) - d_min (>= 0 when satisfied) and its Jacobian w.r.t. p",
+                "distance row d(p, c) - d_min (>= 0 when satisfied), its Jacobian and Hessian w.r.t. p",
                 [("p", p), ("c", c), ("d_min", d_min)],
-                [("g", dist - d_min), ("jac_p", ca.jacobian(dist, p))],
+                [("g", dist - d_min), ("jac_p", ca.jacobian(dist, p)), ("hess_p", hess_d)],
             )
         )
 

@@ -19,6 +19,9 @@ from .spec import IDENT_RE, Spec
 # What a number may look like once printed into C source: a decimal floating literal.
 _C_FLOAT = re.compile(r"^-?[0-9]+(\.[0-9]*)?(e[-+]?[0-9]+)?$")
 
+# Runtime files compiled into the solver's translation unit, in dependency order.
+RUNTIME_SOURCES = ("ocp_qp.c", "ocp_qp_kkt.c", "ocp_qp_ipm.c", "ocp_nlp_sqp.c")
+
 # Template -> file name in the generated folder ({name} is the spec's name).
 TEMPLATES = {
     "solver.h.j2": "{name}.h",
@@ -71,6 +74,8 @@ def runtime_params(spec: Spec) -> list[RuntimeParam]:
         one("d_th", "collision potential threshold distance [m]", cc.d_th),
         one("kappa", "collision potential steepness [1/m]", cc.kappa),
         one("d_h", "hard distance to humans' current positions [m]", spec.humans.d_h),
+        one("human_slack_l1", "exact-penalty weight on the human rows", spec.humans.slack_l1),
+        one("human_slack_l2", "L2 penalty on the human-row slack", spec.humans.slack_l2),
         one("d_s", "soft distance to the closest obstacle [m]", ob.d_s),
         one("slack_l1", "L1 penalty on the obstacle slack", ob.slack_l1),
         one("slack_l2", "L2 penalty on the obstacle slack", ob.slack_l2),
@@ -112,6 +117,8 @@ def template_context(spec: Spec, functions: list[EmittedFunction], real: str) ->
         "N": int(spec.horizon.N),
         "NH": int(spec.humans.max),
         "NG": int(spec.n_rows),
+        "NH_ALLOC": max(1, int(spec.humans.max)),  # C has no zero-length arrays
+        "runtime_sources": RUNTIME_SOURCES,
         "dt": c_float(spec.dt),
         "params": runtime_params(spec),
         "qp_max_iter": int(spec.solver.qp_max_iter),

@@ -185,6 +185,10 @@ class Integrator:
 class Humans:
     max: int = integer(10, "N_h: how many humans the solver handles (a fixed size)", ge=0, le=200)
     d_h: float = number(0.5, "hard minimum distance to a human's current position [m]", ge=0.0, le=100.0)
+    slack_l1: float = number(
+        1e4, "exact-penalty weight on the human rows: must exceed their multipliers", ge=0.0, le=1e9
+    )
+    slack_l2: float = number(100.0, "L2 penalty on the human-row slack (0.5*l2*s^2)", ge=0.0, le=1e9)
 
 
 @dataclass(frozen=True)

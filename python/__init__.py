@@ -7,6 +7,7 @@
 
 from humanmpc.codegen import __version__
 
-from .bindings import Dims, LoadError, Solver, load
+from .bindings import Dims, LoadError, load
+from .solver import Solver, StepResult
 
-__all__ = ["Dims", "LoadError", "Solver", "__version__", "load"]
+__all__ = ["Dims", "LoadError", "Solver", "StepResult", "__version__", "load"]

@@ -20,6 +20,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from humanmpc.codegen.build import build, is_stale
 
+from .solver import Solver
+
 FloatArray = NDArray[np.float64]
 
 
@@ -97,36 +99,6 @@ class ModelFunctions:
         return f"ModelFunctions({', '.join(self._functions)})"
 
 
-class Solver:
-    """A loaded generated solver. For now it exposes its dimensions, parameters and model functions."""
-
-    def __init__(self, solver_dir: Path, manifest: dict[str, Any], ffi: cffi.FFI, lib: Any) -> None:
-        self.path = solver_dir
-        self.name: str = manifest["name"]
-        self.spec_hash: str = manifest["spec_hash"]
-        d = manifest["dims"]
-        self.dims = Dims(nx=d["nx"], nu=d["nu"], N=d["N"], nh=d["nh"], ng=d["ng"], dt=d["dt"], T=d["T"])
-        self._ffi = ffi
-        self._lib = lib
-        self.model = ModelFunctions(
-            {f["name"]: ModelFunction(ffi, getattr(lib, f"{self.name}_{f['name']}"), f) for f in manifest["functions"]}
-        )
-
-    def default_params(self) -> dict[str, Any]:
-        """The runtime parameters with the spec's values, as Python numbers and tuples."""
-        p = self._ffi.new(f"{self.name}_params *")
-        getattr(self._lib, f"{self.name}_params_default")(p)
-        out: dict[str, Any] = {}
-        for field, ftype in self._ffi.typeof(p[0]).fields:
-            value = getattr(p, field)
-            out[field] = tuple(value) if ftype.type.kind == "array" else value
-        return out
-
-    def __repr__(self) -> str:
-        d = self.dims
-        return f"<humanmpc.Solver {self.name!r} N={d.N} nh={d.nh} dt={d.dt:g} from {self.path}>"
-
-
 def load(solver_dir: str | Path, *, build_if_needed: bool = True) -> Solver:
     """Load the generated solver in ``solver_dir`` (compiling it first when its library is stale)."""
     d = Path(solver_dir).resolve()
@@ -146,9 +118,14 @@ def load(solver_dir: str | Path, *, build_if_needed: bool = True) -> Solver:
     if got_hash != manifest["spec_hash"]:
         raise LoadError(f"{d}: the library was built from spec {got_hash[:12]}, the folder holds "
                         f"{manifest['spec_hash'][:12]}; rebuild it")
-    dims = ffi.new("int[5]")
-    getattr(lib, f"{name}_dims")(dims + 0, dims + 1, dims + 2, dims + 3, dims + 4)
+    sizes = ffi.new("int[5]")
+    getattr(lib, f"{name}_dims")(sizes + 0, sizes + 1, sizes + 2, sizes + 3, sizes + 4)
     m = manifest["dims"]
-    if list(dims) != [m["nx"], m["nu"], m["N"], m["nh"], m["ng"]]:
-        raise LoadError(f"{d}: library sizes {list(dims)} do not match the manifest")
-    return Solver(d, manifest, ffi, lib)
+    if list(sizes) != [m["nx"], m["nu"], m["N"], m["nh"], m["ng"]]:
+        raise LoadError(f"{d}: library sizes {list(sizes)} do not match the manifest")
+    m = manifest["dims"]
+    dims_obj = Dims(nx=m["nx"], nu=m["nu"], N=m["N"], nh=m["nh"], ng=m["ng"], dt=m["dt"], T=m["T"])
+    model = ModelFunctions(
+        {f["name"]: ModelFunction(ffi, getattr(lib, f"{name}_{f['name']}"), f) for f in manifest["functions"]}
+    )
+    return Solver(name, dims_obj, ffi, lib, model, d, manifest["spec_hash"])

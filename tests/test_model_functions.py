@@ -61,7 +61,7 @@ def test_dimensions_match_the_spec(paper: humanmpc.Solver) -> None:
 
 
 def test_default_parameters_are_the_specs_values(paper: humanmpc.Solver) -> None:
-    p = paper.default_params()
+    p = paper.params
     assert p["w_goal"] == (0.5, 0.5, 0.0, 250.0)
     assert p["w_goal_terminal"] == (40.0, 40.0, 2.0, 0.0)
     assert (p["q"], p["d_th"], p["kappa"], p["d_h"], p["d_s"]) == (2.0, 1.0, 5.0, 0.5, 0.5)
@@ -141,6 +141,28 @@ def test_collision_cost_is_the_papers_potential_with_exact_gradient_and_gn_hessi
         np.testing.assert_allclose(out.grad_p, fd_grad, rtol=1e-6, atol=1e-7)
         grad_d = central_jacobian(lambda z: paper.model.distance_constraint(z, h, 0.0).g, p)[0]
         np.testing.assert_allclose(out.hess_gn_p, float(f2) * np.outer(grad_d, grad_d), rtol=1e-6, atol=1e-8)
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_exact_second_derivatives_match_finite_differences(paper: humanmpc.Solver, seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    col, con, dyn = paper.model.cost_collision, paper.model.distance_constraint, paper.model.dynamics
+    for _ in range(POINTS // 2):
+        h = rng.uniform(-3, 3, 2)
+        p = h + rng.uniform(0.1, 3.0) * np.array([np.cos(a := rng.uniform(-np.pi, np.pi)), np.sin(a)])
+        q, d_th, kappa = 2.0, rng.uniform(0.3, 2.0), rng.uniform(1, 10)
+        fd_col = central_jacobian(lambda z: col(z, h, q, d_th, kappa).grad_p, p)
+        np.testing.assert_allclose(col(p, h, q, d_th, kappa).hess_p, fd_col, rtol=1e-5, atol=1e-6)
+        fd_con = central_jacobian(lambda z: con(z, h, 0.5).jac_p.reshape(-1), p)
+        np.testing.assert_allclose(con(p, h, 0.5).hess_p, fd_con, rtol=1e-5, atol=1e-6)
+        x, u, pi = random_state(rng), rng.uniform(-1.5, 1.5, 2), rng.uniform(-10, 10, 4)
+        hs = paper.model.dynamics_hessian(x, u, pi)
+        # d/dz of pi' [A B]: rows of the Hessian of pi' F(x, u)
+        grad = lambda z: np.concatenate([pi @ dyn(z[:4], z[4:]).A, pi @ dyn(z[:4], z[4:]).B])  # noqa: E731
+        H = central_jacobian(grad, np.concatenate([x, u]))
+        np.testing.assert_allclose(hs.hess_xx, H[:4, :4], atol=1e-6)
+        np.testing.assert_allclose(hs.hess_ux, H[4:, :4], atol=1e-6)
+        np.testing.assert_allclose(hs.hess_uu, H[4:, 4:], atol=1e-6)
 
 
 def test_gauss_newton_hessian_is_psd_everywhere_including_inside_d_th_and_at_zero(paper: humanmpc.Solver) -> None:

@@ -1,0 +1,585 @@
+/*
+ * ocp_nlp_sqp.c: Gauss-Newton SQP over the human-aware OCP (see ocp_nlp_sqp.h).
+ *
+ * Warm start (real-time iteration): the previous plan is shifted by one interval and its controls
+ * are re-simulated from the predicted state x_1, so the linearisation has no dynamics gaps. Large
+ * gaps are what make linearised human half-planes unreachable after bang-bang steps (measured with
+ * acados on this problem); re-simulation removes them before the QP sees them. The measured state
+ * enters in the feedback phase as the QP's initial-state offset only.
+ */
+#include "ocp_nlp_sqp.h"
+
+#include "ocp_qp.h"
+#include "ocp_qp_ipm.h"
+
+static int ocp_nlp_clamp_humans(const hm_input *in)
+{
+    int nh = in->n_humans;
+    if (nh < 0) nh = 0;
+    if (nh > HM_NG - 1) nh = HM_NG - 1;
+    return nh;
+}
+
+static unsigned long long ocp_nlp_now(const hm_solver *s)
+{
+    return s->clock ? s->clock(s->clock_ctx) : 0ULL;
+}
+
+HM_FUNC void ocp_nlp_sqp_init(hm_solver *s, const hm_params *params)
+{
+    s->params = *params;
+    ocp_qp_ipm_arg_set_default(&s->ipm_arg);
+#if defined(HM_HAVE_POSIX_CLOCK)
+    s->clock = hm_clock_posix_ns;
+#else
+    s->clock = 0;
+#endif
+    s->clock_ctx = 0;
+    ocp_nlp_sqp_reset(s);
+}
+
+HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
+{
+    int n, i;
+    s->warm = 0;
+    s->prepared = 0;
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) s->u[n][i] = HM_R(0.0);
+    for (n = 0; n <= HM_N; n++)
+        for (i = 0; i < HM_NX; i++) s->x[n][i] = HM_R(0.0);
+    s->cost = HM_R(0.0);
+    s->time_prepare_ms = HM_R(0.0);
+}
+
+/* x_{n+1} = F(x_n, u_n) for n = 0..N-1 from the given x_0. */
+static void ocp_nlp_simulate(hm_solver *s)
+{
+    int n;
+    hm_real A[HM_NX * HM_NX], B[HM_NX * HM_NU];
+    for (n = 0; n < HM_N; n++) hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], A, B);
+}
+
+/* a[r][.] <- a[r + 1][.] for r < rows - 1; the last row is kept. */
+static void ocp_nlp_shift_rows(hm_real *a, int rows, int cols)
+{
+    int k;
+    for (k = 0; k < (rows - 1) * cols; k++) a[k] = a[k + cols];
+}
+
+/* Initial guess of the next step: the previous plan shifted by one interval (the last control
+ * repeated), re-simulated from the predicted state; or, cold, the controls held at zero from x0. */
+static void ocp_nlp_shift(hm_solver *s, const hm_input *in)
+{
+    int n, i;
+    if (!s->warm) {
+        for (i = 0; i < HM_NX; i++) s->x[0][i] = in->x0[i];
+        for (n = 0; n < HM_N; n++)
+            for (i = 0; i < HM_NU; i++) s->u[n][i] = HM_R(0.0);
+    } else {
+        hm_ocp_qp_sol *m = &s->mult;
+        for (i = 0; i < HM_NX; i++) s->x[0][i] = s->x[1][i];
+        for (n = 0; n + 1 < HM_N; n++)
+            for (i = 0; i < HM_NU; i++) s->u[n][i] = s->u[n + 1][i];
+        /* The multipliers follow their stages (they only enter the reported residuals). */
+        ocp_nlp_shift_rows(&m->pi[0][0], HM_N, HM_NX);
+        ocp_nlp_shift_rows(&m->lam_lbu[0][0], HM_N, HM_NU);
+        ocp_nlp_shift_rows(&m->lam_ubu[0][0], HM_N, HM_NU);
+        ocp_nlp_shift_rows(&m->lam_lbx[0][0], HM_N + 1, HM_NX);
+        ocp_nlp_shift_rows(&m->lam_ubx[0][0], HM_N + 1, HM_NX);
+        ocp_nlp_shift_rows(&m->lam_lg[0][0], HM_N + 1, HM_NG);
+        ocp_nlp_shift_rows(&m->lam_ls[0][0], HM_N + 1, HM_NG);
+    }
+    ocp_nlp_simulate(s);
+}
+
+static hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2)
+{
+    /* The slack a row needs at this point: s = max(0, -g). */
+    const hm_real sl = g < HM_R(0.0) ? -g : HM_R(0.0);
+    return l1 * sl + HM_R(0.5) * l2 * sl * sl;
+}
+
+/* Symmetric n x n M (column-major, n <= 6) replaced by its projection onto {eigenvalues >= floor}:
+ * cyclic Jacobi rotations, then V max(Lambda, floor) V'. */
+static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
+{
+    hm_real V[36], off, total = HM_R(0.0);
+    int i, j, k, sweep;
+    for (i = 0; i < n * n; i++) {
+        V[i] = HM_R(0.0);
+        total += M[i] * M[i];
+    }
+    for (i = 0; i < n; i++) V[i + i * n] = HM_R(1.0);
+    for (sweep = 0; sweep < 30; sweep++) {
+        off = HM_R(0.0);
+        for (i = 0; i < n; i++)
+            for (j = i + 1; j < n; j++) off += M[i + j * n] * M[i + j * n];
+        if (off <= HM_EPS * HM_EPS * total) break;
+        for (i = 0; i < n; i++) {
+            for (j = i + 1; j < n; j++) {
+                const hm_real mij = M[i + j * n];
+                hm_real theta, t, c, sn;
+                if (mij == HM_R(0.0)) continue;
+                theta = (M[j + j * n] - M[i + i * n]) / (HM_R(2.0) * mij);
+                t = (theta >= HM_R(0.0) ? HM_R(1.0) : HM_R(-1.0)) / (hm_fabs(theta) + hm_sqrt(theta * theta + HM_R(1.0)));
+                c = HM_R(1.0) / hm_sqrt(t * t + HM_R(1.0));
+                sn = t * c;
+                for (k = 0; k < n; k++) { /* M <- M J */
+                    const hm_real a = M[k + i * n], b = M[k + j * n];
+                    M[k + i * n] = c * a - sn * b;
+                    M[k + j * n] = sn * a + c * b;
+                }
+                for (k = 0; k < n; k++) { /* M <- J' M */
+                    const hm_real a = M[i + k * n], b = M[j + k * n];
+                    M[i + k * n] = c * a - sn * b;
+                    M[j + k * n] = sn * a + c * b;
+                }
+                for (k = 0; k < n; k++) { /* V <- V J */
+                    const hm_real a = V[k + i * n], b = V[k + j * n];
+                    V[k + i * n] = c * a - sn * b;
+                    V[k + j * n] = sn * a + c * b;
+                }
+            }
+        }
+    }
+    {
+        hm_real lam[6];
+        for (k = 0; k < n; k++) lam[k] = hm_fmax(M[k + k * n], floor);
+        for (i = 0; i < n; i++) {
+            for (j = 0; j < n; j++) {
+                hm_real acc = HM_R(0.0);
+                for (k = 0; k < n; k++) acc += V[i + k * n] * lam[k] * V[j + k * n];
+                M[i + j * n] = acc;
+            }
+        }
+    }
+}
+
+/* Stage n's Hessian blocks [Q S'; S R] (or Q alone at n = N) projected onto the PSD cone. */
+static void ocp_nlp_convexify_stage(hm_ocp_qp *qp, int n, hm_real floor)
+{
+    hm_real M[36];
+    const int nz = n < HM_N ? HM_NX + HM_NU : HM_NX;
+    int i, j;
+    for (j = 0; j < HM_NX; j++)
+        for (i = 0; i < HM_NX; i++) M[i + j * nz] = qp->Q[n][i + j * HM_NX];
+    if (n < HM_N) {
+        for (j = 0; j < HM_NX; j++)
+            for (i = 0; i < HM_NU; i++) {
+                M[HM_NX + i + j * nz] = qp->S[n][i + j * HM_NU];
+                M[j + (HM_NX + i) * nz] = qp->S[n][i + j * HM_NU];
+            }
+        for (j = 0; j < HM_NU; j++)
+            for (i = 0; i < HM_NU; i++) M[HM_NX + i + (HM_NX + j) * nz] = qp->R[n][i + j * HM_NU];
+    }
+    ocp_nlp_project_psd(M, nz, floor);
+    for (j = 0; j < HM_NX; j++)
+        for (i = 0; i < HM_NX; i++) qp->Q[n][i + j * HM_NX] = M[i + j * nz];
+    if (n < HM_N) {
+        for (j = 0; j < HM_NX; j++)
+            for (i = 0; i < HM_NU; i++) qp->S[n][i + j * HM_NU] = M[HM_NX + i + j * nz];
+        for (j = 0; j < HM_NU; j++)
+            for (i = 0; i < HM_NU; i++) qp->R[n][i + j * HM_NU] = M[HM_NX + i + (HM_NX + j) * nz];
+    }
+}
+
+/* Build the QP of the current iterate (everything but the initial-state offset) and the NLP
+ * objective there. Rows: the present humans first, then the obstacle; absent ones cost nothing.
+ * exact = 0: Gauss-Newton Hessian (PSD by construction). exact = 1: the Hessian of the Lagrangian
+ * with the multipliers in s->mult, projected per stage onto the PSD cone (full SQP). */
+static void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
+{
+    const hm_params *p = &s->params;
+    hm_ocp_qp *qp = &s->qp;
+    const int nh = ocp_nlp_clamp_humans(in);
+    const int ng = nh + (in->has_obstacle ? 1 : 0);
+    const hm_real reg = p->regularization;
+    hm_real cost = HM_R(0.0), penalty = HM_R(0.0);
+    int n, i, j;
+
+    for (n = 0; n <= HM_N; n++) {
+        hm_real *x = s->x[n];
+        hm_real *Q = qp->Q[n];
+        hm_real *q = qp->q[n];
+        hm_real l;
+
+        if (n < HM_N) {
+            hm_real x_next[HM_NX];
+            hm_model_dynamics(x, s->u[n], x_next, qp->A[n], qp->B[n]);
+            for (i = 0; i < HM_NX; i++) qp->b[n][i] = x_next[i] - s->x[n + 1][i];
+            hm_model_cost_stage(x, s->u[n], in->goal, p->w_goal, p->w_control, &l, q, qp->r[n], Q, qp->R[n]);
+            for (i = 0; i < HM_NU; i++) qp->R[n][i + i * HM_NU] += reg;
+            for (i = 0; i < HM_NU * HM_NX; i++) qp->S[n][i] = HM_R(0.0);
+            if (exact) {
+                hm_real hxx[HM_NX * HM_NX], hux[HM_NU * HM_NX], huu[HM_NU * HM_NU];
+                hm_model_dynamics_hessian(x, s->u[n], s->mult.pi[n], hxx, hux, huu);
+                for (i = 0; i < HM_NX * HM_NX; i++) Q[i] += hxx[i];
+                for (i = 0; i < HM_NU * HM_NX; i++) qp->S[n][i] = hux[i];
+                for (i = 0; i < HM_NU * HM_NU; i++) qp->R[n][i] += huu[i];
+            }
+            qp->lbu[n][0] = p->a_bounds[0] - s->u[n][0];
+            qp->ubu[n][0] = p->a_bounds[1] - s->u[n][0];
+            qp->lbu[n][1] = p->omega_bounds[0] - s->u[n][1];
+            qp->ubu[n][1] = p->omega_bounds[1] - s->u[n][1];
+        } else {
+            hm_model_cost_terminal(x, in->goal, p->w_goal_terminal, &l, q, Q);
+        }
+        for (i = 0; i < HM_NX; i++) Q[i + i * HM_NX] += reg;
+        cost += l;
+
+        /* Collision cost of each present human at its predicted position at this node: exact
+         * gradient, Gauss-Newton Hessian on the (px, py) block. */
+        for (j = 0; j < nh; j++) {
+            hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP], hess_exact[HM_NP * HM_NP];
+            const hm_real *hess = exact ? hess_exact : hess_gn;
+            hm_model_cost_collision(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn,
+                                    hess_exact);
+            cost += f;
+            q[0] += grad[0];
+            q[1] += grad[1];
+            Q[0] += hess[0];
+            Q[1] += hess[1];
+            Q[HM_NX] += hess[2];
+            Q[HM_NX + 1] += hess[3];
+        }
+
+        /* Node 0 is the measured state: its bounds and rows cannot be acted on. */
+        for (i = 0; i < HM_NX; i++) {
+            qp->lbx[n][i] = -HM_INF;
+            qp->ubx[n][i] = HM_INF;
+        }
+        if (n == 0) {
+            qp->ng[0] = 0;
+            continue;
+        }
+        qp->lbx[n][3] = p->v_bounds[0] - x[3];
+        qp->ubx[n][3] = p->v_bounds[1] - x[3];
+        qp->ng[n] = ng;
+        for (j = 0; j < ng; j++) {
+            const int human = j < nh;
+            const hm_real *c = human ? in->humans_now[j] : in->obstacle;
+            const hm_real *d_min = human ? &p->d_h : &p->d_s;
+            const hm_real l1 = human ? p->human_slack_l1 : p->slack_l1;
+            const hm_real l2 = human ? p->human_slack_l2 : p->slack_l2;
+            hm_real g, hess_d[HM_NP * HM_NP];
+            hm_model_distance_constraint(x, c, d_min, &g, qp->D[n][j], hess_d);
+            if (exact) {
+                /* L = cost - lam (d - d_min + s): the row's curvature enters with -lam. */
+                const hm_real lam = s->mult.lam_lg[n][j];
+                Q[0] -= lam * hess_d[0];
+                Q[1] -= lam * hess_d[1];
+                Q[HM_NX] -= lam * hess_d[2];
+                Q[HM_NX + 1] -= lam * hess_d[3];
+            }
+            qp->lg[n][j] = -g;
+            qp->soft[n][j] = 1;
+            qp->zl[n][j] = l1;
+            qp->Zl[n][j] = l2;
+            penalty += ocp_nlp_slack_penalty(g, l1, l2);
+        }
+    }
+    if (exact)
+        for (n = 0; n <= HM_N; n++) ocp_nlp_convexify_stage(qp, n, hm_fmax(reg, HM_R(1e-8)));
+    s->cost = cost + penalty;
+    s->cost_slack = penalty;
+    s->n_active = ng;
+}
+
+HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in)
+{
+    const unsigned long long t0 = ocp_nlp_now(s);
+    ocp_nlp_shift(s, in);
+    ocp_nlp_linearize(s, in, 0);
+    s->prepared = 1;
+    s->time_prepare_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
+}
+
+/* Solve the QP of the current linearisation (its x0 offset set). Returns the QP status. */
+static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int *qp_iter)
+{
+    int status;
+    s->ipm_arg.max_iter = s->params.qp_max_iter;
+    s->ipm_arg.tol = tol;
+    status = ocp_qp_ipm_solve(&s->qp, &s->qp_sol, &s->ipm_ws, &s->ipm_arg);
+    *qp_iter += s->ipm_ws.iter;
+    return status;
+}
+
+static int ocp_nlp_qp_usable(int status)
+{
+    return status == HM_QP_SOLVED || status == HM_QP_MAX_ITER;
+}
+
+/* Iterate = base + alpha * QP step (base: the linearisation point, kept in x_base/u_base). */
+static void ocp_nlp_step_from_base(hm_solver *s, hm_real alpha)
+{
+    int n, i;
+    const hm_ocp_qp_sol *d = &s->qp_sol;
+    for (n = 0; n <= HM_N; n++)
+        for (i = 0; i < HM_NX; i++) s->x[n][i] = s->x_base[n][i] + alpha * d->x[n][i];
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) s->u[n][i] = s->u_base[n][i] + alpha * d->u[n][i];
+}
+
+static void ocp_nlp_save_base(hm_solver *s)
+{
+    int n, i;
+    for (n = 0; n <= HM_N; n++)
+        for (i = 0; i < HM_NX; i++) s->x_base[n][i] = s->x[n][i];
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) s->u_base[n][i] = s->u[n][i];
+}
+
+/* The QP's multipliers become the NLP's; their primal part is kept zero so that the residuals
+ * read the NLP at the iterate (ocp_nlp_residuals). */
+static void ocp_nlp_take_multipliers(hm_solver *s)
+{
+    int n, i, j;
+    s->mult = s->qp_sol;
+    for (n = 0; n <= HM_N; n++) {
+        for (i = 0; i < HM_NX; i++) s->mult.x[n][i] = HM_R(0.0);
+        for (j = 0; j < HM_NG; j++) s->mult.s[n][j] = HM_R(0.0);
+    }
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) s->mult.u[n][i] = HM_R(0.0);
+}
+
+/* Solve the QP; when usable, take the full step (real-time iteration). */
+static int ocp_nlp_qp_step(hm_solver *s, int *qp_iter)
+{
+    const int status = ocp_nlp_qp_solve(s, s->params.qp_tol, qp_iter);
+    if (!ocp_nlp_qp_usable(status)) return status;
+    ocp_nlp_save_base(s);
+    ocp_nlp_step_from_base(s, HM_R(1.0));
+    ocp_nlp_take_multipliers(s);
+    return status;
+}
+
+/* l1 merit of the iterate: objective with the soft-row penalties + mu * (|dynamics gaps|_1 +
+ * |x_0 - measured x0|_1). Bounds are linear, so every step of the line search keeps them. */
+static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
+{
+    const hm_params *p = &s->params;
+    const int nh = ocp_nlp_clamp_humans(in);
+    const int ng = nh + (in->has_obstacle ? 1 : 0);
+    hm_real merit = HM_R(0.0), gaps = HM_R(0.0);
+    int n, i, j;
+    for (i = 0; i < HM_NX; i++) gaps += hm_fabs(s->x[0][i] - in->x0[i]);
+    for (n = 0; n <= HM_N; n++) {
+        const hm_real *x = s->x[n];
+        hm_real l, gx[HM_NX], hx[HM_NX * HM_NX];
+        if (n < HM_N) {
+            hm_real gu[HM_NU], hu[HM_NU * HM_NU], x_next[HM_NX], A[HM_NX * HM_NX], B[HM_NX * HM_NU];
+            hm_model_dynamics(x, s->u[n], x_next, A, B);
+            for (i = 0; i < HM_NX; i++) gaps += hm_fabs(x_next[i] - s->x[n + 1][i]);
+            hm_model_cost_stage(x, s->u[n], in->goal, p->w_goal, p->w_control, &l, gx, gu, hx, hu);
+        } else {
+            hm_model_cost_terminal(x, in->goal, p->w_goal_terminal, &l, gx, hx);
+        }
+        merit += l;
+        for (j = 0; j < nh; j++) {
+            hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP], hess[HM_NP * HM_NP];
+            hm_model_cost_collision(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn, hess);
+            merit += f;
+        }
+        if (n == 0) continue;
+        for (j = 0; j < ng; j++) {
+            const int human = j < nh;
+            hm_real g, jac[HM_NP], hess_d[HM_NP * HM_NP];
+            hm_model_distance_constraint(x, human ? in->humans_now[j] : in->obstacle, human ? &p->d_h : &p->d_s,
+                                         &g, jac, hess_d);
+            merit += ocp_nlp_slack_penalty(g, human ? p->human_slack_l1 : p->slack_l1,
+                                           human ? p->human_slack_l2 : p->slack_l2);
+        }
+    }
+    return merit + mu * gaps;
+}
+
+/* Full SQP step with a backtracking line search on the l1 merit (Armijo on the decrease that the
+ * QP model predicts); mu grows to stay above the dynamics multipliers, as exactness requires. */
+static int ocp_nlp_qp_line_search_step(hm_solver *s, const hm_input *in, hm_real tol, int *qp_iter)
+{
+    /* The QP must be solved at least as tightly as the SQP is asked to converge. */
+    const int status = ocp_nlp_qp_solve(s, hm_fmin(s->params.qp_tol, HM_R(0.1) * tol), qp_iter);
+    hm_real gaps = HM_R(0.0), pi_max = HM_R(0.0), merit0, predicted, alpha = HM_R(1.0);
+    int n, i;
+    if (!ocp_nlp_qp_usable(status)) return status;
+    for (i = 0; i < HM_NX; i++) gaps += hm_fabs(s->qp.x0[i]);
+    for (n = 0; n < HM_N; n++) {
+        for (i = 0; i < HM_NX; i++) {
+            gaps += hm_fabs(s->qp.b[n][i]);
+            pi_max = hm_fmax(pi_max, hm_fabs(s->qp_sol.pi[n][i]));
+        }
+    }
+    s->merit_mu = hm_fmax(s->merit_mu, HM_R(2.0) * pi_max + HM_R(1.0));
+    merit0 = s->cost + s->merit_mu * gaps;
+    /* The QP model of the merit after the full step: smooth objective + QP objective (its slack
+     * penalties included) and linearised gaps closed. */
+    predicted = merit0 - (s->cost - s->cost_slack + s->ipm_ws.res.obj);
+    ocp_nlp_save_base(s);
+    for (;;) {
+        ocp_nlp_step_from_base(s, alpha);
+        if (alpha <= HM_R(1e-4)) break;
+        if (ocp_nlp_merit(s, in, s->merit_mu) <= merit0 - HM_R(1e-4) * alpha * hm_fmax(predicted, HM_R(0.0)))
+            break;
+        alpha *= HM_R(0.5);
+    }
+    ocp_nlp_take_multipliers(s);
+    return status;
+}
+
+/* The measured state enters the QP as the offset of its fixed x_0 from the iterate's. */
+static void ocp_nlp_set_x0(hm_solver *s, const hm_input *in)
+{
+    int i;
+    for (i = 0; i < HM_NX; i++) s->qp.x0[i] = in->x0[i] - s->x[0][i];
+}
+
+/* KKT residuals of the NLP at the linearisation point with the multipliers in s->mult: exactly those
+ * of the QP of this linearisation at a zero step (its gradient is the NLP's, its constraints are the
+ * NLP's linearised here), soft rows carrying the slack they need at this point. */
+static void ocp_nlp_residuals(hm_solver *s, hm_output *out)
+{
+    hm_ocp_qp *qp = &s->qp;
+    hm_ocp_qp_sol *m = &s->mult;
+    hm_ocp_qp_res res;
+    hm_real gap = HM_R(0.0);
+    int n, j, i;
+    for (i = 0; i < HM_NX; i++) {
+        m->x[0][i] = qp->x0[i];
+        gap = hm_fmax(gap, hm_fabs(qp->x0[i]));
+    }
+    for (n = 0; n <= HM_N; n++)
+        for (j = 0; j < HM_NG; j++)
+            m->s[n][j] = (j < qp->ng[n] && qp->lg[n][j] > HM_R(0.0)) ? qp->lg[n][j] : HM_R(0.0);
+    ocp_qp_res_compute(qp, m, &res);
+    for (i = 0; i < HM_NX; i++) m->x[0][i] = HM_R(0.0);
+    out->kkt_stat = res.stat;
+    out->kkt_eq = hm_fmax(res.eq, gap);
+    out->kkt_ineq = res.ineq;
+    out->kkt_comp = res.comp;
+}
+
+static hm_real ocp_nlp_min_human_distance(const hm_solver *s, const hm_input *in)
+{
+    const int nh = ocp_nlp_clamp_humans(in);
+    hm_real best = HM_INF;
+    int n, j;
+    for (n = 0; n <= HM_N; n++) {
+        for (j = 0; j < nh; j++) {
+            const hm_real dx = s->x[n][0] - in->humans_now[j][0];
+            const hm_real dy = s->x[n][1] - in->humans_now[j][1];
+            const hm_real d = hm_sqrt(dx * dx + dy * dy);
+            if (d < best) best = d;
+        }
+    }
+    return best;
+}
+
+static void ocp_nlp_report(const hm_solver *s, const hm_input *in, hm_output *out)
+{
+    int n, i;
+    for (n = 0; n <= HM_N; n++)
+        for (i = 0; i < HM_NX; i++) out->x[n][i] = s->x[n][i];
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) out->u[n][i] = s->u[n][i];
+    out->u0[0] = s->u[0][0];
+    out->u0[1] = s->u[0][1];
+    out->command[0] = s->x[1][3];
+    out->command[1] = s->u[0][1];
+    out->cost = s->cost;
+    out->min_human_distance = ocp_nlp_min_human_distance(s, in);
+}
+
+HM_FUNC int ocp_nlp_sqp_rti_feedback(hm_solver *s, const hm_input *in, hm_output *out)
+{
+    unsigned long long t0;
+    int qp_status, status;
+    if (!s->prepared) ocp_nlp_sqp_rti_prepare(s, in);
+    t0 = ocp_nlp_now(s);
+    out->qp_iterations = 0;
+    if (!s->warm) ocp_qp_sol_set_zero(&s->mult);
+    ocp_nlp_set_x0(s, in);
+    qp_status = ocp_nlp_qp_step(s, &out->qp_iterations);
+    /* With the multipliers of this QP: how far the linearisation point is from a KKT point. */
+    ocp_nlp_residuals(s, out);
+    s->prepared = 0;
+    if (qp_status == HM_QP_SOLVED) {
+        status = HM_STATUS_OK;
+    } else if (qp_status == HM_QP_MAX_ITER) {
+        status = HM_STATUS_MAX_ITER;
+    } else {
+        /* No usable step: start the next one from a cold guess rather than from a plan that the
+         * QP could not improve (a failed QP tends to stay failed when warm started from it). */
+        status = HM_STATUS_QP_FAILED;
+        s->warm = 0;
+    }
+    if (status != HM_STATUS_QP_FAILED) s->warm = 1;
+    out->status = status;
+    out->qp_status = qp_status;
+    out->sqp_iterations = 1;
+    ocp_nlp_report(s, in, out);
+    out->time_prepare_ms = s->time_prepare_ms;
+    out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
+    out->time_total_ms = out->time_prepare_ms + out->time_feedback_ms;
+    return status;
+}
+
+HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol)
+{
+    const unsigned long long t0 = ocp_nlp_now(s);
+    int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER;
+    if (!s->warm) {
+        ocp_nlp_shift(s, in); /* cold: controls held at zero from x0 */
+        ocp_qp_sol_set_zero(&s->mult);
+        s->warm = 1;
+    }
+    s->merit_mu = HM_R(1.0);
+    out->qp_iterations = 0;
+    for (k = 0; k < max_iter; k++) {
+        ocp_nlp_linearize(s, in, k > 0);
+        ocp_nlp_set_x0(s, in);
+        ocp_nlp_residuals(s, out);
+        if (k > 0 && out->kkt_stat <= tol && out->kkt_eq <= tol && out->kkt_ineq <= tol && out->kkt_comp <= tol) {
+            status = HM_STATUS_OK;
+            break;
+        }
+        qp_status = ocp_nlp_qp_line_search_step(s, in, tol, &out->qp_iterations);
+        if (!ocp_nlp_qp_usable(qp_status)) {
+            status = HM_STATUS_QP_FAILED;
+            s->warm = 0;
+            break;
+        }
+    }
+    if (k == max_iter) {
+        /* Report the residuals at the final iterate. */
+        ocp_nlp_linearize(s, in, 1);
+        ocp_nlp_set_x0(s, in);
+        ocp_nlp_residuals(s, out);
+        if (out->kkt_stat <= tol && out->kkt_eq <= tol && out->kkt_ineq <= tol && out->kkt_comp <= tol)
+            status = HM_STATUS_OK;
+    }
+    s->prepared = 0;
+    out->status = status;
+    out->qp_status = qp_status;
+    out->sqp_iterations = k;
+    ocp_nlp_report(s, in, out);
+    out->time_prepare_ms = HM_R(0.0);
+    out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
+    out->time_total_ms = out->time_feedback_ms;
+    return status;
+}
+
+HM_FUNC const char *ocp_nlp_status_message(int status)
+{
+    switch (status) {
+    case HM_STATUS_OK:
+        return "solved";
+    case HM_STATUS_MAX_ITER:
+        return "iteration limit reached before the tolerance";
+    case HM_STATUS_QP_FAILED:
+        return "the QP failed; no step taken";
+    default:
+        return "unknown status";
+    }
+}

@@ -1,0 +1,35 @@
+/*
+ * ocp_nlp_types.h: the sized types of the SQP solver, instantiated once per solver like
+ * hm_types.h (no include guard; same HM_NS / HM_REAL / HM_N / HM_NG contract). Included by a
+ * generated public header after hm_types.h and after its own <name>_params, <name>_input and
+ * <name>_output structs, which the solver embeds.
+ */
+/* The Gauss-Newton SQP (real-time iteration and full) over the OCP: all memory of a solver, so that
+ * the caller may place it statically. */
+typedef unsigned long long (*HM_NS(clock_fn))(void *ctx); /* monotonic time in nanoseconds */
+
+typedef struct HM_NS(solver) {
+    HM_NS(params) params;
+    /* The iterate (linearisation point) and the multipliers of the last QP. */
+    HM_REAL x[HM_N + 1][HM_NX];
+    HM_REAL u[HM_N][HM_NU];
+    HM_NS(ocp_qp_sol) mult;
+    int warm;        /* 1: x, u, mult hold a previous solution to shift */
+    int prepared;    /* 1: qp holds the linearisation for the next feedback */
+    int n_active;    /* humans and obstacle rows of the current linearisation */
+    /* The QP of the current linearisation and its solver. */
+    HM_NS(ocp_qp) qp;
+    HM_NS(ocp_qp_sol) qp_sol;
+    HM_NS(ocp_qp_ipm_arg) ipm_arg;
+    HM_NS(ocp_qp_ipm_ws) ipm_ws;
+    /* The linearisation point during a line search (full SQP). */
+    HM_REAL x_base[HM_N + 1][HM_NX];
+    HM_REAL u_base[HM_N][HM_NU];
+    HM_REAL merit_mu;
+    /* Evaluations kept from the linearisation for the residuals and the report. */
+    HM_REAL cost;         /* objective at the linearisation point, soft-row penalties included */
+    HM_REAL cost_slack;   /* the penalties alone */
+    HM_REAL time_prepare_ms;
+    HM_NS(clock_fn) clock;
+    void *clock_ctx;
+} HM_NS(solver);

@@ -1,0 +1,220 @@
+/*
+ * ocp_qp.c: helpers on the data of the stage-structured QP (see ocp_qp.h).
+ */
+#include "ocp_qp.h"
+
+HM_FUNC void ocp_qp_set_zero(hm_ocp_qp *qp)
+{
+    int n, i, j;
+    for (n = 0; n <= HM_N; n++) {
+        for (i = 0; i < HM_NX * HM_NX; i++) qp->Q[n][i] = HM_R(0.0);
+        for (i = 0; i < HM_NX; i++) {
+            qp->q[n][i] = HM_R(0.0);
+            qp->lbx[n][i] = -HM_INF;
+            qp->ubx[n][i] = HM_INF;
+        }
+        qp->ng[n] = 0;
+        for (i = 0; i < HM_NG; i++) {
+            for (j = 0; j < HM_NP; j++) qp->D[n][i][j] = HM_R(0.0);
+            qp->lg[n][i] = -HM_INF;
+            qp->soft[n][i] = 0;
+            qp->zl[n][i] = HM_R(0.0);
+            qp->Zl[n][i] = HM_R(0.0);
+        }
+    }
+    for (n = 0; n < HM_N; n++) {
+        for (i = 0; i < HM_NX * HM_NX; i++) qp->A[n][i] = HM_R(0.0);
+        for (i = 0; i < HM_NX * HM_NU; i++) {
+            qp->B[n][i] = HM_R(0.0);
+            qp->S[n][i] = HM_R(0.0);
+        }
+        for (i = 0; i < HM_NU * HM_NU; i++) qp->R[n][i] = HM_R(0.0);
+        for (i = 0; i < HM_NX; i++) qp->b[n][i] = HM_R(0.0);
+        for (i = 0; i < HM_NU; i++) {
+            qp->r[n][i] = HM_R(0.0);
+            qp->lbu[n][i] = -HM_INF;
+            qp->ubu[n][i] = HM_INF;
+        }
+    }
+    for (i = 0; i < HM_NX; i++) qp->x0[i] = HM_R(0.0);
+}
+
+HM_FUNC void ocp_qp_sol_set_zero(hm_ocp_qp_sol *sol)
+{
+    int n, i;
+    for (n = 0; n <= HM_N; n++) {
+        for (i = 0; i < HM_NX; i++) {
+            sol->x[n][i] = HM_R(0.0);
+            sol->lam_lbx[n][i] = HM_R(0.0);
+            sol->lam_ubx[n][i] = HM_R(0.0);
+        }
+        for (i = 0; i < HM_NG; i++) {
+            sol->s[n][i] = HM_R(0.0);
+            sol->lam_lg[n][i] = HM_R(0.0);
+            sol->lam_ls[n][i] = HM_R(0.0);
+        }
+    }
+    for (n = 0; n < HM_N; n++) {
+        for (i = 0; i < HM_NX; i++) sol->pi[n][i] = HM_R(0.0);
+        for (i = 0; i < HM_NU; i++) {
+            sol->u[n][i] = HM_R(0.0);
+            sol->lam_lbu[n][i] = HM_R(0.0);
+            sol->lam_ubu[n][i] = HM_R(0.0);
+        }
+    }
+}
+
+HM_FUNC int ocp_qp_bound_present(hm_real bound)
+{
+    return !HM_IS_INF(bound);
+}
+
+/* 1 if all of v[0..len-1] are finite. Sums would be cheaper but overflow on large finite data. */
+HM_FUNC int ocp_qp_all_finite(const hm_real *v, int len)
+{
+    int i;
+    for (i = 0; i < len; i++) {
+        if (!isfinite(v[i])) return 0;
+    }
+    return 1;
+}
+
+/* Bounds may be infinite (absent), never NaN. */
+HM_FUNC int ocp_qp_no_nan(const hm_real *v, int len)
+{
+    int i;
+    for (i = 0; i < len; i++) {
+        if (isnan(v[i])) return 0;
+    }
+    return 1;
+}
+
+HM_FUNC int ocp_qp_check(const hm_ocp_qp *qp)
+{
+    int n, i;
+    if (!ocp_qp_all_finite(&qp->A[0][0], HM_N * HM_NX * HM_NX)
+        || !ocp_qp_all_finite(&qp->B[0][0], HM_N * HM_NX * HM_NU)
+        || !ocp_qp_all_finite(&qp->b[0][0], HM_N * HM_NX)
+        || !ocp_qp_all_finite(&qp->Q[0][0], (HM_N + 1) * HM_NX * HM_NX)
+        || !ocp_qp_all_finite(&qp->S[0][0], HM_N * HM_NU * HM_NX)
+        || !ocp_qp_all_finite(&qp->R[0][0], HM_N * HM_NU * HM_NU)
+        || !ocp_qp_all_finite(&qp->q[0][0], (HM_N + 1) * HM_NX)
+        || !ocp_qp_all_finite(&qp->r[0][0], HM_N * HM_NU)
+        || !ocp_qp_all_finite(qp->x0, HM_NX)
+        || !ocp_qp_no_nan(&qp->lbu[0][0], HM_N * HM_NU)
+        || !ocp_qp_no_nan(&qp->ubu[0][0], HM_N * HM_NU)
+        || !ocp_qp_no_nan(&qp->lbx[1][0], HM_N * HM_NX)
+        || !ocp_qp_no_nan(&qp->ubx[1][0], HM_N * HM_NX))
+        return HM_QP_NONFINITE;
+    for (n = 1; n <= HM_N; n++) {
+        if (qp->ng[n] < 0 || qp->ng[n] > HM_NG) return HM_QP_NONFINITE;
+        for (i = 0; i < qp->ng[n]; i++) {
+            if (!ocp_qp_all_finite(qp->D[n][i], HM_NP) || isnan(qp->lg[n][i])) return HM_QP_NONFINITE;
+            if (qp->soft[n][i] && (!isfinite(qp->zl[n][i]) || !isfinite(qp->Zl[n][i])))
+                return HM_QP_NONFINITE;
+        }
+    }
+    return 0;
+}
+
+/* max that propagates a NaN in b, so that a broken solution cannot look like a good one */
+HM_FUNC hm_real ocp_qp_max(hm_real a, hm_real b)
+{
+    return (b > a || isnan(b)) ? b : a;
+}
+
+/* Violation of lb <= v <= ub, complementarity and multiplier signs of one bounded component. */
+HM_FUNC void ocp_qp_res_bound(hm_real v, hm_real lb, hm_real ub, hm_real lam_lb, hm_real lam_ub,
+                              hm_ocp_qp_res *res)
+{
+    if (ocp_qp_bound_present(lb)) {
+        res->ineq = ocp_qp_max(res->ineq, lb - v);
+        res->comp = ocp_qp_max(res->comp, hm_fabs(lam_lb * (v - lb)));
+    }
+    if (ocp_qp_bound_present(ub)) {
+        res->ineq = ocp_qp_max(res->ineq, v - ub);
+        res->comp = ocp_qp_max(res->comp, hm_fabs(lam_ub * (ub - v)));
+    }
+    res->dual = ocp_qp_max(res->dual, ocp_qp_max(-lam_lb, -lam_ub));
+}
+
+HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, hm_ocp_qp_res *res)
+{
+    int n, i, j, k, ng_n;
+    hm_real obj = HM_R(0.0);
+    res->stat = HM_R(0.0);
+    res->eq = HM_R(0.0);
+    res->ineq = HM_R(0.0);
+    res->comp = HM_R(0.0);
+    res->dual = HM_R(0.0);
+    for (j = 0; j < HM_NX; j++) res->eq = ocp_qp_max(res->eq, hm_fabs(sol->x[0][j] - qp->x0[j]));
+
+    for (n = 0; n <= HM_N; n++) {
+        /* the problem fixes x_0: stage 0 is evaluated at qp->x0, not at whatever sol->x[0] holds */
+        const hm_real *x = n == 0 ? qp->x0 : sol->x[n];
+        hm_real gx[HM_NX], gu[HM_NU];
+        for (i = 0; i < HM_NX; i++) {
+            hm_real acc = qp->q[n][i];
+            for (k = 0; k < HM_NX; k++) acc += qp->Q[n][i + k * HM_NX] * x[k];
+            gx[i] = acc;
+            obj += x[i] * (qp->q[n][i] + HM_R(0.5) * (acc - qp->q[n][i]));
+        }
+        if (n < HM_N) {
+            const hm_real *u = sol->u[n];
+            for (i = 0; i < HM_NU; i++) {
+                hm_real su = HM_R(0.0), ru = HM_R(0.0);
+                for (k = 0; k < HM_NX; k++) su += qp->S[n][i + k * HM_NU] * x[k];
+                for (k = 0; k < HM_NU; k++) ru += qp->R[n][i + k * HM_NU] * u[k];
+                gu[i] = ru + su + qp->r[n][i] - sol->lam_lbu[n][i] + sol->lam_ubu[n][i];
+                obj += u[i] * (su + HM_R(0.5) * ru + qp->r[n][i]);
+                for (k = 0; k < HM_NX; k++) gu[i] += qp->B[n][k + i * HM_NX] * sol->pi[n][k];
+            }
+            for (k = 0; k < HM_NX; k++) {
+                for (i = 0; i < HM_NU; i++) gx[k] += qp->S[n][i + k * HM_NU] * u[i];
+                for (i = 0; i < HM_NX; i++) gx[k] += qp->A[n][i + k * HM_NX] * sol->pi[n][i];
+            }
+            for (i = 0; i < HM_NX; i++) {
+                hm_real acc = qp->b[n][i] - sol->x[n + 1][i];
+                for (k = 0; k < HM_NX; k++) acc += qp->A[n][i + k * HM_NX] * x[k];
+                for (k = 0; k < HM_NU; k++) acc += qp->B[n][i + k * HM_NX] * u[k];
+                res->eq = ocp_qp_max(res->eq, hm_fabs(acc));
+            }
+            for (i = 0; i < HM_NU; i++) {
+                res->stat = ocp_qp_max(res->stat, hm_fabs(gu[i]));
+                ocp_qp_res_bound(u[i], qp->lbu[n][i], qp->ubu[n][i], sol->lam_lbu[n][i],
+                                 sol->lam_ubu[n][i], res);
+            }
+        }
+        if (n == 0) continue;
+        /* ng out of range is invalid data (ocp_qp_check); its residuals are still evaluated safely */
+        ng_n = qp->ng[n] < 0 ? 0 : (qp->ng[n] > HM_NG ? HM_NG : qp->ng[n]);
+        for (i = 0; i < HM_NX; i++) {
+            gx[i] += sol->lam_ubx[n][i] - sol->lam_lbx[n][i] - sol->pi[n - 1][i];
+            ocp_qp_res_bound(x[i], qp->lbx[n][i], qp->ubx[n][i], sol->lam_lbx[n][i],
+                             sol->lam_ubx[n][i], res);
+        }
+        for (i = 0; i < ng_n; i++) {
+            const hm_real lam = sol->lam_lg[n][i];
+            const int soft = qp->soft[n][i] != 0;
+            const hm_real s = soft ? sol->s[n][i] : HM_R(0.0);
+            hm_real g;
+            if (!ocp_qp_bound_present(qp->lg[n][i])) continue;
+            gx[0] -= qp->D[n][i][0] * lam;
+            gx[1] -= qp->D[n][i][1] * lam;
+            g = qp->D[n][i][0] * x[0] + qp->D[n][i][1] * x[1] + s - qp->lg[n][i];
+            res->ineq = ocp_qp_max(res->ineq, -g);
+            res->comp = ocp_qp_max(res->comp, hm_fabs(lam * g));
+            res->dual = ocp_qp_max(res->dual, -lam);
+            if (soft) {
+                const hm_real gs = qp->Zl[n][i] * s + qp->zl[n][i] - lam - sol->lam_ls[n][i];
+                res->stat = ocp_qp_max(res->stat, hm_fabs(gs));
+                res->ineq = ocp_qp_max(res->ineq, -s);
+                res->comp = ocp_qp_max(res->comp, hm_fabs(sol->lam_ls[n][i] * s));
+                res->dual = ocp_qp_max(res->dual, -sol->lam_ls[n][i]);
+                obj += s * (qp->zl[n][i] + HM_R(0.5) * qp->Zl[n][i] * s);
+            }
+        }
+        for (i = 0; i < HM_NX; i++) res->stat = ocp_qp_max(res->stat, hm_fabs(gx[i]));
+    }
+    res->obj = obj;
+}

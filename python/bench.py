@@ -1,0 +1,233 @@
+"""Timing benchmark of the real-time iteration in random crowds (humanmpc-gen bench).
+
+For each crowd size k a solver with N_h = k is generated and built, then driven in a seeded closed
+loop: the robot (the unicycle, integrated finely) crosses an area with k humans walking at constant
+velocity (re-entering on the far side when they leave it), constant-velocity predictions, and one
+static obstacle near the path; one RTI step per control period. Reported per k: the step time as
+the C code measures it and as Python sees it (binding included), the preparation/feedback split,
+QP iterations and statuses, and the closest robot-human distance.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+from collections import Counter
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from humanmpc.codegen.build import build
+from humanmpc.codegen.generate import generate
+from humanmpc.codegen.spec import Spec, resolve_spec
+
+from .bindings import load
+from .solver import QP_STATUS_NAMES, Solver
+
+AREA_X = (-1.0, 13.0)
+AREA_Y = (-5.0, 5.0)
+OBSTACLE_CENTRE = np.array([6.0, 0.9])
+OBSTACLE_RADIUS = 0.3
+
+
+@dataclass(frozen=True)
+class TimingStats:
+    mean: float
+    median: float
+    min: float
+    max: float
+    p99: float
+
+    @staticmethod
+    def of(samples: Sequence[float]) -> TimingStats:
+        a = np.asarray(samples, dtype=float)
+        return TimingStats(mean=float(a.mean()), median=float(np.median(a)), min=float(a.min()),
+                           max=float(a.max()), p99=float(np.percentile(a, 99)))
+
+
+@dataclass(frozen=True)
+class BenchResult:
+    humans: int
+    steps: int
+    seeds: int
+    c_total_ms: TimingStats
+    python_ms: TimingStats
+    prepare_share: float  # of the C total
+    qp_iterations_mean: float
+    qp_iterations_max: int
+    qp_status: dict[str, int]
+    solved_fraction: float
+    min_human_distance: float
+
+
+def _unicycle(x: np.ndarray, u: np.ndarray, dt: float, substeps: int = 10) -> np.ndarray:
+    h = dt / substeps
+    for _ in range(substeps):
+        x = x + h * np.array([x[3] * np.cos(x[2]), x[3] * np.sin(x[2]), u[1], u[0]])
+    return x
+
+
+class CrowdScene:
+    """k humans at constant velocity in a box; a human leaving it re-enters on the opposite side."""
+
+    def __init__(self, k: int, rng: np.random.Generator, robot_xy: np.ndarray) -> None:
+        self.rng = rng
+        pos = []
+        while len(pos) < k:
+            p = np.array([rng.uniform(1.0, 12.0), rng.uniform(*AREA_Y)])
+            if np.linalg.norm(p - robot_xy) > 2.0:
+                pos.append(p)
+        self.pos = np.array(pos).reshape(k, 2)
+        speed = rng.uniform(0.3, 1.2, k)
+        heading = rng.uniform(-np.pi, np.pi, k)
+        self.vel = np.column_stack([speed * np.cos(heading), speed * np.sin(heading)])
+
+    def predict(self, N: int, dt: float) -> np.ndarray:
+        return np.stack([self.pos + self.vel * dt * n for n in range(N + 1)])
+
+    def advance(self, dt: float) -> None:
+        self.pos = self.pos + self.vel * dt
+        width = AREA_X[1] - AREA_X[0]
+        height = AREA_Y[1] - AREA_Y[0]
+        self.pos[:, 0] = (self.pos[:, 0] - AREA_X[0]) % width + AREA_X[0]
+        self.pos[:, 1] = (self.pos[:, 1] - AREA_Y[0]) % height + AREA_Y[0]
+
+
+def nearest_obstacle_point(p: np.ndarray) -> np.ndarray:
+    d = p - OBSTACLE_CENTRE
+    n = float(np.linalg.norm(d))
+    return OBSTACLE_CENTRE + (d / n if n > 1e-9 else np.array([1.0, 0.0])) * OBSTACLE_RADIUS
+
+
+def run_closed_loop(solver: Solver, k: int, seed: int, steps: int,
+                    record: Callable[[dict[str, Any]], None] | None = None) -> dict[str, list[float]]:
+    """One seeded closed loop; returns per-step samples. record(inputs) sees every step's inputs."""
+    rng = np.random.default_rng(seed)
+    dims = solver.dims
+    x = np.array([0.0, 0.0, 0.0, 0.0])
+    goals = [np.array([12.0, 0.0, 0.0, 0.8]), np.array([0.0, 0.0, np.pi, 0.8])]
+    goal_index = 0
+    scene = CrowdScene(k, rng, x[:2])
+    solver.reset()
+    out: dict[str, list[float]] = {key: [] for key in
+                                   ("c_ms", "py_ms", "prep_ms", "qp_iter", "qp_status", "dist")}
+    for _ in range(steps):
+        goal = goals[goal_index].copy()
+        dist_goal = float(np.hypot(*(goal[:2] - x[:2])))
+        if dist_goal < 0.3:
+            goal_index = 1 - goal_index
+            goal = goals[goal_index].copy()
+            dist_goal = float(np.hypot(*(goal[:2] - x[:2])))
+        goal[3] = min(goal[3], 0.5 * dist_goal)
+        pred = scene.predict(dims.N, dims.dt)
+        obstacle = nearest_obstacle_point(x[:2])
+        if record is not None:
+            record({"x0": x.copy(), "goal": goal, "humans_now": scene.pos.copy(), "humans_pred": pred,
+                    "obstacle": obstacle})
+        t0 = time.perf_counter_ns()
+        r = solver.step(x, goal, scene.pos, pred, obstacle)
+        t1 = time.perf_counter_ns()
+        out["c_ms"].append(r.time_total_ms)
+        out["py_ms"].append((t1 - t0) * 1e-6)
+        out["prep_ms"].append(r.time_prepare_ms)
+        out["qp_iter"].append(r.qp_iterations)
+        out["qp_status"].append(r.qp_status)
+        out["dist"].append(float(np.min(np.linalg.norm(scene.pos - x[:2], axis=1))) if k else np.inf)
+        u = r.u0 if np.all(np.isfinite(r.u0)) else np.array([-1.0, 0.0])
+        x = _unicycle(x, u, dims.dt)
+        x[3] = min(max(x[3], 0.0), 1.0)
+        scene.advance(dims.dt)
+    return out
+
+
+def bench_solver(solver: Solver, k: int, seeds: int, steps: int) -> BenchResult:
+    samples: dict[str, list[float]] = {}
+    for seed in range(seeds):
+        for key, vals in run_closed_loop(solver, k, seed, steps).items():
+            samples.setdefault(key, []).extend(vals)
+    statuses = Counter(QP_STATUS_NAMES.get(int(s), str(s)) for s in samples["qp_status"])
+    c_total = sum(samples["c_ms"])
+    return BenchResult(
+        humans=k, steps=len(samples["c_ms"]), seeds=seeds,
+        c_total_ms=TimingStats.of(samples["c_ms"]), python_ms=TimingStats.of(samples["py_ms"]),
+        prepare_share=sum(samples["prep_ms"]) / c_total if c_total > 0 else 0.0,
+        qp_iterations_mean=statistics.fmean(samples["qp_iter"]), qp_iterations_max=int(max(samples["qp_iter"])),
+        qp_status=dict(statuses), solved_fraction=statuses.get("solved", 0) / len(samples["qp_status"]),
+        min_human_distance=float(min(samples["dist"])),
+    )
+
+
+def pin_to_one_core() -> str:
+    """Pin this process to the last CPU it may use (less interference from the shell's)."""
+    try:
+        cpus = sorted(os.sched_getaffinity(0))
+        os.sched_setaffinity(0, {cpus[-1]})
+        return f"pinned to CPU {cpus[-1]} of {len(cpus)}"
+    except (AttributeError, OSError) as err:
+        return f"not pinned ({err})"
+
+
+def machine_description() -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} CPUs, Python {platform.python_version()}, {platform.system()}"
+
+
+def markdown_table(results: Sequence[BenchResult]) -> str:
+    rows = [
+        "| N_h | steps | C step mean / median / min / max / p99 [ms] | Python step mean / p99 / max [ms] "
+        "| prep. share | QP iter mean / max | QP status | min dist [m] |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in results:
+        c, p = r.c_total_ms, r.python_ms
+        status = ", ".join(f"{k}: {v}" for k, v in sorted(r.qp_status.items()))
+        rows.append(
+            f"| {r.humans} | {r.steps} | {c.mean:.3f} / {c.median:.3f} / {c.min:.3f} / {c.max:.3f} / {c.p99:.3f} "
+            f"| {p.mean:.3f} / {p.p99:.3f} / {p.max:.3f} | {100 * r.prepare_share:.0f}% "
+            f"| {r.qp_iterations_mean:.1f} / {r.qp_iterations_max} | {status} | {r.min_human_distance:.2f} |"
+        )
+    return "\n".join(rows) + "\n"
+
+
+def bench_spec(base: Spec, k: int) -> Spec:
+    data = base.to_dict()
+    data["name"] = f"bench_h{k}"
+    data["humans"]["max"] = k
+    return resolve_spec(data)
+
+
+def run_bench(base: Spec, humans: Sequence[int], *, seeds: int = 3, steps: int = 300,
+              out_dir: Path = Path("out/bench"), log: Callable[[str], None] | None = None) -> list[BenchResult]:
+    say = log or (lambda m: print(m, file=sys.stderr))
+    say(f"[bench] {pin_to_one_core()}; {machine_description()}")
+    results = []
+    for k in humans:
+        solver_dir = out_dir / "solvers" / f"bench_h{k}"
+        generate(bench_spec(base, k), solver_dir, force=True, log=say)
+        build(solver_dir, log=say)
+        solver = load(solver_dir)
+        say(f"[bench] N_h = {k}: {seeds} seeds x {steps} RTI steps ...")
+        res = bench_solver(solver, k, seeds, steps)
+        say(f"[bench] N_h = {k}: mean {res.python_ms.mean:.3f} ms (Python), {res.c_total_ms.mean:.3f} ms (C), "
+            f"p99 {res.python_ms.p99:.3f} ms, QP solved {100 * res.solved_fraction:.1f}%")
+        results.append(res)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    payload = {"machine": machine_description(), "spec_base": base.to_dict(),
+               "results": [asdict(r) for r in results]}
+    (out_dir / "bench.json").write_text(json.dumps(payload, indent=2) + "\n")
+    (out_dir / "bench.md").write_text(markdown_table(results))
+    return results

@@ -1,0 +1,624 @@
+"""Side by side with the references: humanmpc's SQP-RTI, acados SQP-RTI + HPIPM, Ipopt in C.
+
+Every solver gets the same replay (the inputs of every step of a closed loop, see
+:mod:`humanmpc.replay`), step by step, each keeping its own warm start:
+
+=================  ====================================================================  ==========================
+solver             what runs                                                             step time
+=================  ====================================================================  ==========================
+humanmpc           ``humanmpc.load(DIR).step`` (one RTI step, C through cffi)            its own timer (total ms)
+acados default     acados_template SQP_RTI, PARTIAL_CONDENSING_HPIPM, HPIPM defaults     acados' ``time_tot``
+acados fastest     the same with hpipm_mode SPEED_ABS, partial condensing to 5 stages   acados' ``time_tot``
+Ipopt cold         ``<name>_ipopt`` (Debian Ipopt, exact Hessian) from x_n = x0, u = 0    ``IpoptSolve`` wall time
+Ipopt warm         the same from the previous solution shifted by one interval           ``IpoptSolve`` wall time
+=================  ====================================================================  ==========================
+
+Relative cumulative sub-optimality (RCSO), as in the acados paper (Verschueren et al. 2021)::
+
+    RCSO = sum_t (J_t(solver) - J*_t) / sum_t J*_t
+
+over the steps t where the solver succeeded (status 0; its failures are reported apart: a failed
+RTI step returns a plan of no meaning, which would swamp the sum) and the reference J*_t exists,
+where
+
+- J_t(solver) is the NLP objective of the plan the solver returned at step t, evaluated by ONE
+  function for every solver (``ReferenceNlp.plan_cost``): the solver's planned controls u_0..u_{N-1}
+  are simulated from the measured x0_t with the model's RK4 (so every plan is dynamically
+  consistent, whatever the solver's own states), and each obstacle slack takes its smallest
+  feasible value max(0, d_s - d). Hard-row violations of the plan are not in J; they are reported
+  separately (largest violation of d >= d_h by a plan the solver called solved, in metres,
+  over the steps the reference found feasible);
+- J*_t is the lowest cost (the same function) of Ipopt's plans at step t, over its cold and warm
+  runs that succeeded (the problem is not convex: the two can end in different local optima).
+  Steps where neither succeeded are left out, as are steps where a solver returned non-finite
+  controls; ``rcso_steps`` says how many steps remain.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from humanmpc.codegen.ocp import DIST_EPS
+from humanmpc.codegen.reference_nlp import ReferenceNlp
+from humanmpc.codegen.spec import Spec, load_spec, resolve_spec
+
+from .reference_ipopt import IpoptRun, IpoptUnavailableError, build_ipopt_reference, ipopt_unavailable_reason
+from .replay import Replay, ReplayRun, replay_solver, synthetic_replay
+
+FloatArray = NDArray[np.float64]
+Log = Callable[[str], None]
+
+ACADOS_PACKAGE = "comma-deps-acados==0.2.2.post104"
+ACADOS_PYTHON = "3.12"
+PEER_SCRIPT = Path(__file__).resolve().parent / "peers" / "acados_peer.py"
+DEFAULT_ACADOS_VENV = Path(".venv-acados")
+SOLVERS = ("humanmpc", "acados default", "acados fastest", "Ipopt cold", "Ipopt warm")
+FASTEST = {"cond_N": 5, "qp_iter_max": 50}
+
+
+class AcadosUnavailableError(RuntimeError):
+    """acados cannot run here (no Python 3.12, or its wheel cannot be installed); the message says why."""
+
+
+def _say(log: Log | None) -> Log:
+    return log or (lambda msg: print(msg, file=sys.stderr))
+
+
+# ----------------------------------------------------------------------------------------------
+# The acados virtualenv (Python 3.12, separate from the project's .venv)
+# ----------------------------------------------------------------------------------------------
+
+
+def find_python312() -> Path | None:
+    """A Python 3.12 interpreter: $HUMANMPC_PYTHON312, python3.12 on PATH, or a pyenv 3.12.x."""
+    candidates: list[Path] = []
+    env = os.environ.get("HUMANMPC_PYTHON312")
+    if env:
+        candidates.append(Path(env))
+    which = shutil.which("python3.12")
+    if which:
+        candidates.append(Path(which))
+    pyenv_root = Path(os.environ.get("PYENV_ROOT", Path.home() / ".pyenv"))
+    candidates += sorted((pyenv_root / "versions").glob("3.12*/bin/python3.12"), reverse=True)
+    for c in candidates:
+        if not c.is_file():
+            continue
+        try:
+            out = subprocess.run([str(c), "-c", "import sys, venv; print('%d.%d' % sys.version_info[:2])"],
+                                 capture_output=True, text=True, timeout=30, check=False)
+        except (OSError, subprocess.TimeoutExpired):
+            continue
+        if out.returncode == 0 and out.stdout.strip() == ACADOS_PYTHON:
+            return c
+    return None
+
+
+def _venv_python(venv_dir: Path) -> Path:
+    return venv_dir / "bin" / "python"
+
+
+def _acados_installed(python: Path) -> bool:
+    probe = "import importlib.util as u, sys; sys.exit(0 if u.find_spec('acados') and u.find_spec('casadi') else 1)"
+    try:
+        return subprocess.run([str(python), "-c", probe], capture_output=True, timeout=60, check=False).returncode == 0
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+
+
+def ensure_acados_venv(venv_dir: str | Path = DEFAULT_ACADOS_VENV, *, log: Log | None = None) -> Path:
+    """The interpreter of a Python 3.12 virtualenv holding PyPI's prebuilt acados (created when missing).
+
+    The virtualenv is separate from the project's: acados ships a casadi of its own (3.6.7)
+    that must not meet the project's. Raises AcadosUnavailableError with the reason when Python
+    3.12 is missing or the wheel cannot be installed.
+    """
+    say = _say(log)
+    d = Path(venv_dir).resolve()
+    python = _venv_python(d)
+    if python.is_file() and _acados_installed(python):
+        return python
+    base = find_python312()
+    if base is None:
+        raise AcadosUnavailableError(
+            "acados needs Python 3.12 (PyPI's comma-deps-acados is built for it) and none was found: "
+            "install python3.12 (or pyenv 3.12.x) or point HUMANMPC_PYTHON312 at one"
+        )
+    if not python.is_file():
+        say(f"[compare] creating {d} with {base}")
+        proc = subprocess.run([str(base), "-m", "venv", str(d)], capture_output=True, text=True, check=False)
+        if proc.returncode != 0:
+            raise AcadosUnavailableError(f"could not create the acados virtualenv {d}: {proc.stderr.strip()[-500:]}")
+    say(f"[compare] installing {ACADOS_PACKAGE} into {d}")
+    proc = subprocess.run([str(python), "-m", "pip", "install", "-q", ACADOS_PACKAGE], capture_output=True, text=True,
+                          check=False)
+    if proc.returncode != 0 or not _acados_installed(python):
+        raise AcadosUnavailableError(f"could not install {ACADOS_PACKAGE} into {d}: "
+                                     f"{(proc.stderr or proc.stdout).strip()[-800:]}")
+    return python
+
+
+def acados_unavailable_reason(venv_dir: str | Path = DEFAULT_ACADOS_VENV) -> str | None:
+    """None when the acados peer can run (installing it if needed), else the reason (for skips)."""
+    try:
+        ensure_acados_venv(venv_dir, log=lambda _m: None)
+    except AcadosUnavailableError as err:
+        return str(err)
+    return None
+
+
+@dataclass
+class AcadosRun:
+    """acados' results on every step of a replay."""
+
+    mode: str
+    status: NDArray[np.int64]  # (T,) acados' status: 0 success, 3 minimum step, 4 QP failure, ...
+    qp_iterations: NDArray[np.int64]
+    time_tot_ms: FloatArray  # acados' own timer
+    wall_ms: FloatArray  # wall time of solve() from Python (ctypes)
+    x: FloatArray
+    u: FloatArray
+    info: dict[str, Any]
+
+    @property
+    def failures(self) -> int:
+        return int(np.count_nonzero(self.status != 0))
+
+
+def run_acados(replay: Replay, mode: str, build_dir: str | Path, *, python: Path | None = None,
+               venv_dir: str | Path = DEFAULT_ACADOS_VENV, regularization: float | None = None,
+               cond_n: int = FASTEST["cond_N"], qp_iter_max: int = FASTEST["qp_iter_max"],
+               timeout_s: float = 3600.0, log: Log | None = None) -> AcadosRun:
+    """Run the acados peer (``peers/acados_peer.py``) on a replay, in ``mode`` default or fastest."""
+    py = python or ensure_acados_venv(venv_dir, log=log)
+    build = Path(build_dir).resolve()
+    build.mkdir(parents=True, exist_ok=True)
+    reg = replay.resolved_spec().solver.regularization if regularization is None else regularization
+    with tempfile.TemporaryDirectory(prefix="hm_acados_") as tmp:
+        rp, out = Path(tmp) / "replay.npz", Path(tmp) / "results.npz"
+        replay.save(rp)
+        cmd = [str(py), str(PEER_SCRIPT), str(rp), str(out), "--build", str(build), "--mode", mode,
+               "--dist-eps", repr(DIST_EPS), "--cond-N", str(cond_n), "--qp-iter-max", str(qp_iter_max),
+               "--regularization", repr(float(reg))]
+        env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout_s, check=False, env=env)
+        if proc.returncode != 0 or not out.is_file():
+            raise RuntimeError(f"the acados peer failed (exit {proc.returncode}):\n"
+                               f"{(proc.stderr + proc.stdout).strip()[-3000:]}")
+        with np.load(out, allow_pickle=False) as r:
+            return AcadosRun(mode=mode, status=r["status"].astype(np.int64),
+                             qp_iterations=r["qp_iter"].astype(np.int64), time_tot_ms=r["time_tot_ms"].copy(),
+                             wall_ms=r["wall_ms"].copy(), x=r["x"].copy(), u=r["u"].copy(),
+                             info=json.loads(str(r["info"])))
+
+
+# ----------------------------------------------------------------------------------------------
+# Sub-optimality
+# ----------------------------------------------------------------------------------------------
+
+
+def plan_costs(nlp: ReferenceNlp, replay: Replay, u: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Per step: the objective of the controls u[t] (N, 2) simulated from x0_t, and the largest
+    violation of the hard human rows by that trajectory (m, 0 when none). NaN where u is not finite."""
+    T = replay.steps
+    costs = np.full(T, np.nan)
+    violation = np.full(T, np.nan)
+    for t in range(T):
+        ut = np.asarray(u[t], dtype=np.float64)
+        if not np.all(np.isfinite(ut)):
+            continue
+        inputs = replay.inputs(t)
+        p = nlp.params.pack(**inputs, params=replay.params)
+        X = np.asarray(nlp.rollout(inputs["x0"], ut))
+        costs[t] = float(nlp.plan_cost(X, ut, p))
+        now = inputs["humans_now"]
+        if now.shape[0]:
+            # the problem's smoothed distance, as in the constraint rows
+            d = np.sqrt(np.sum((X[1:, None, :2] - now[None, :, :]) ** 2, axis=2) + DIST_EPS**2)
+            violation[t] = max(0.0, float(np.max(float(np.asarray(replay.params["d_h"]).reshape(-1)[0]) - d)))
+        else:
+            violation[t] = 0.0
+    return costs, violation
+
+
+def reference_costs(costs: Sequence[FloatArray], success: Sequence[NDArray[np.bool_]]) -> FloatArray:
+    """J*_t: the lowest cost among the reference runs that succeeded at step t (NaN where none did).
+
+    ``costs[k]`` are run k's plan costs (``plan_costs``, the same function as for every solver),
+    ``success[k]`` its per-step success."""
+    if not costs or len(costs) != len(success):
+        raise ValueError("give the costs and the success flags of at least one reference run")
+    stacked = np.stack([np.where(np.asarray(ok, dtype=bool), np.asarray(c, dtype=np.float64), np.nan)
+                        for c, ok in zip(costs, success, strict=True)])
+    out = np.full(stacked.shape[1], np.nan)
+    ok = np.any(np.isfinite(stacked), axis=0)
+    out[ok] = np.nanmin(stacked[:, ok], axis=0)
+    return out
+
+
+def rcso(costs: Sequence[float] | FloatArray, optimal: Sequence[float] | FloatArray) -> tuple[float, int]:
+    """Relative cumulative sub-optimality and the number of steps it covers.
+
+    sum_t (costs_t - optimal_t) / sum_t optimal_t over the steps where both are finite.
+    """
+    c = np.asarray(costs, dtype=np.float64)
+    o = np.asarray(optimal, dtype=np.float64)
+    if c.shape != o.shape:
+        raise ValueError(f"costs {c.shape} and optimal costs {o.shape} must have the same shape")
+    ok = np.isfinite(c) & np.isfinite(o)
+    if not np.any(ok):
+        return float("nan"), 0
+    total = float(np.sum(o[ok]))
+    if total <= 0.0:
+        raise ValueError(f"the optimal costs sum to {total}: RCSO needs a positive total")
+    return float(np.sum(c[ok] - o[ok]) / total), int(np.count_nonzero(ok))
+
+
+# ----------------------------------------------------------------------------------------------
+# The comparison
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass
+class SolverStats:
+    solver: str
+    n_humans: int
+    steps: int
+    mean_ms: float = float("nan")
+    min_ms: float = float("nan")
+    max_ms: float = float("nan")
+    p99_ms: float = float("nan")
+    ratio_to_ours: float = float("nan")
+    iterations_mean: float = float("nan")
+    iterations_max: int = -1
+    failures: int = 0
+    rcso: float = float("nan")
+    rcso_steps: int = 0
+    max_violation_m: float = float("nan")
+    wall_mean_ms: float = float("nan")
+    error: str | None = None
+    times_ms: list[float] = field(default_factory=list)
+
+
+def _time_stats(s: SolverStats, times: FloatArray) -> None:
+    s.times_ms = [float(v) for v in times]
+    if times.size:
+        s.mean_ms, s.min_ms, s.max_ms = float(np.mean(times)), float(np.min(times)), float(np.max(times))
+        s.p99_ms = float(np.percentile(times, 99))
+
+
+def _finish(s: SolverStats, nlp: ReferenceNlp, replay: Replay, u: FloatArray, ok: NDArray[np.bool_],
+            optimal: FloatArray | None) -> None:
+    """RCSO over the steps the solver solved (its failures are counted apart) and the largest
+    violation of the human rows by the plans it called solved, over the steps where the
+    reference found the problem feasible."""
+    costs, viol = plan_costs(nlp, replay, u)
+    feasible = np.isfinite(optimal) if optimal is not None else np.ones(replay.steps, dtype=bool)
+    v = viol[ok & feasible & np.isfinite(viol)]
+    s.max_violation_m = float(np.max(v)) if v.size else float("nan")
+    if optimal is not None:
+        s.rcso, s.rcso_steps = rcso(np.where(ok, costs, np.nan), optimal)
+
+
+def _load_spec(item: Spec | str | Path) -> Spec:
+    return item if isinstance(item, Spec) else load_spec(item)
+
+
+def machine_description() -> dict[str, str]:
+    cpu = platform.processor() or "unknown CPU"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+
+    def version(cmd: list[str]) -> str:
+        try:
+            out = subprocess.run(cmd, capture_output=True, text=True, timeout=10, check=False)
+            return (out.stdout or out.stderr).strip().splitlines()[0] if out.returncode == 0 else "n/a"
+        except (OSError, subprocess.TimeoutExpired, IndexError):
+            return "n/a"
+
+    return {
+        "cpu": cpu, "cores": str(os.cpu_count()), "os": f"{platform.system()} {platform.release()}",
+        "python": platform.python_version(), "cc": version(["cc", "--version"]),
+        "ipopt": version(["pkg-config", "--modversion", "ipopt"]), "acados": ACADOS_PACKAGE,
+    }
+
+
+def compare(specs: Sequence[Spec | str | Path], replays: Sequence[Replay | str | Path] | None, out_dir: str | Path,
+            *, steps: int = 100, seed: int = 0, solver_dirs: Sequence[str | Path] | None = None,
+            acados_venv: str | Path = DEFAULT_ACADOS_VENV, skip: Sequence[str] = (), command: str = "",
+            log: Log | None = None) -> dict[str, Any]:
+    """Run every solver on the replay of every spec (e.g. N_h = 5, 10, 20, 30) and write the report.
+
+    ``replays[i]`` belongs to ``specs[i]``; None makes a synthetic replay per spec
+    (``synthetic_replay(spec, N_h, steps, seed)``). ``solver_dirs[i]`` is a generated humanmpc
+    solver of ``specs[i]``; None generates one under out_dir/solvers. Writes to ``out_dir``:
+    ``results.json``, ``step_times.png`` and ``benchmarks.md`` (a section for docs/benchmarks.md).
+    Solvers in ``skip`` are left out; a solver that cannot run here is reported with the reason.
+    """
+    say = _say(log)
+    out = Path(out_dir).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    spec_list = [_load_spec(s) for s in specs]
+    if replays is not None and len(replays) != len(spec_list):
+        raise ValueError(f"{len(spec_list)} specs but {len(replays)} replays: give one replay per spec")
+    if solver_dirs is not None and len(solver_dirs) != len(spec_list):
+        raise ValueError(f"{len(spec_list)} specs but {len(solver_dirs)} solver folders")
+    unknown = sorted(set(skip) - set(SOLVERS))
+    if unknown:
+        raise ValueError(f"unknown solver(s) to skip: {', '.join(unknown)}; solvers are {', '.join(SOLVERS)}")
+
+    acados_python: Path | None = None
+    acados_reason: str | None = None
+    if not {"acados default", "acados fastest"} <= set(skip):
+        try:
+            acados_python = ensure_acados_venv(acados_venv, log=say)
+        except AcadosUnavailableError as err:
+            acados_reason = str(err)
+            say(f"[compare] acados skipped: {acados_reason}")
+    ipopt_reason = ipopt_unavailable_reason()
+
+    rows: list[SolverStats] = []
+    for i, spec in enumerate(spec_list):
+        if replays is None:
+            say(f"[compare] recording a synthetic replay: N_h={spec.humans.max}, {steps} steps, seed {seed}")
+            replay = synthetic_replay(spec, spec.humans.max, steps, seed)
+            replay.save(out / f"replay_{spec.name}_{spec.humans.max}.npz")
+        else:
+            r = replays[i]
+            replay = r if isinstance(r, Replay) else Replay.load(r)
+        if replay.spec_hash != spec.digest():
+            raise ValueError(f"replay {i} was recorded for spec {replay.spec_hash[:12]}, not for spec {spec.name} "
+                             f"({spec.digest()[:12]})")
+        nh = int(spec.humans.max)
+        nlp = ReferenceNlp(spec)
+        T = replay.steps
+        say(f"[compare] N_h={nh}: {T} steps")
+
+        ipopt_runs: dict[str, IpoptRun] = {}
+        if not {"Ipopt cold", "Ipopt warm"} <= set(skip) and ipopt_reason is None:
+            try:
+                ref = build_ipopt_reference(spec, out / "ipopt" / f"{spec.name}_{nh}")
+                for label, warm in (("Ipopt cold", False), ("Ipopt warm", True)):
+                    say(f"[compare]   {label}")
+                    ipopt_runs[label] = ref.run(replay, warm=warm)
+            except (IpoptUnavailableError, RuntimeError) as err:
+                ipopt_reason = str(err)
+        optimal = None
+        if ipopt_runs:
+            optimal = reference_costs([plan_costs(nlp, replay, r.u)[0] for r in ipopt_runs.values()],
+                                      [r.success for r in ipopt_runs.values()])
+
+        group: list[SolverStats] = []
+        # -- humanmpc ----------------------------------------------------------------------
+        s = SolverStats("humanmpc", nh, T)
+        if "humanmpc" not in skip:
+            try:
+                run = _run_ours(spec, None if solver_dirs is None else solver_dirs[i], out, replay, say)
+                _time_stats(s, run.time_ms)
+                s.wall_mean_ms = float(np.mean(run.wall_ms))
+                s.iterations_mean = float(np.mean(run.qp_iterations))
+                s.iterations_max = int(np.max(run.qp_iterations))
+                s.failures = run.failures
+                _finish(s, nlp, replay, run.u, run.status == 0, optimal)
+            except Exception as err:  # reported in the table; the other solvers still run
+                s.error = f"{type(err).__name__}: {err}"
+            group.append(s)
+        # -- acados ------------------------------------------------------------------------
+        for label, mode in (("acados default", "default"), ("acados fastest", "fastest")):
+            if label in skip:
+                continue
+            s = SolverStats(label, nh, T)
+            if acados_python is None:
+                s.error = acados_reason
+            else:
+                try:
+                    say(f"[compare]   {label}")
+                    ar = run_acados(replay, mode, out / "acados", python=acados_python, log=say)
+                    _time_stats(s, ar.time_tot_ms)
+                    s.wall_mean_ms = float(np.mean(ar.wall_ms))
+                    s.iterations_mean = float(np.mean(ar.qp_iterations))
+                    s.iterations_max = int(np.max(ar.qp_iterations))
+                    s.failures = ar.failures
+                    _finish(s, nlp, replay, ar.u, ar.status == 0, optimal)
+                except Exception as err:  # reported in the table
+                    s.error = f"{type(err).__name__}: {err}"
+            group.append(s)
+        # -- Ipopt -------------------------------------------------------------------------
+        for label in ("Ipopt cold", "Ipopt warm"):
+            if label in skip:
+                continue
+            s = SolverStats(label, nh, T)
+            if label not in ipopt_runs:
+                s.error = ipopt_reason or "not run"
+            else:
+                ir = ipopt_runs[label]
+                _time_stats(s, ir.solve_ms)
+                s.wall_mean_ms = float(np.mean(ir.total_ms))
+                s.iterations_mean = float(np.mean(ir.iterations))
+                s.iterations_max = int(np.max(ir.iterations))
+                s.failures = ir.failures
+                _finish(s, nlp, replay, ir.u, ir.success, optimal)
+            group.append(s)
+        ours = next((g for g in group if g.solver == "humanmpc" and g.error is None), None)
+        for g in group:
+            if ours is not None and g.error is None and ours.mean_ms > 0:
+                g.ratio_to_ours = g.mean_ms / ours.mean_ms
+        rows += group
+
+    report: dict[str, Any] = {
+        "machine": machine_description(), "command": command, "date": time.strftime("%Y-%m-%d %H:%M:%S"),
+        "rows": [asdict(r) for r in rows],
+    }
+    (out / "results.json").write_text(json.dumps(report, indent=1, default=float) + "\n")
+    plot_step_times(rows, out / "step_times.png")
+    (out / "benchmarks.md").write_text(markdown_section(rows, report["machine"], command))
+    say(f"[compare] wrote {out / 'benchmarks.md'}, {out / 'results.json'}, {out / 'step_times.png'}")
+    return report
+
+
+def _run_ours(spec: Spec, solver_dir: str | Path | None, out: Path, replay: Replay, say: Log) -> ReplayRun:
+    import humanmpc  # the package itself; imported here so that compare.py loads without a built solver
+
+    if solver_dir is None:
+        from humanmpc.codegen.generate import generate
+
+        solver_dir = generate(spec, out / "solvers" / f"{spec.name}_{spec.humans.max}", force=True,
+                              log=lambda _m: None)
+    solver = humanmpc.load(solver_dir)
+    say(f"[compare]   humanmpc ({solver_dir})")
+    return replay_solver(solver, replay, name="humanmpc")
+
+
+# ----------------------------------------------------------------------------------------------
+# Report: plot and Markdown
+# ----------------------------------------------------------------------------------------------
+
+
+def plot_step_times(rows: Sequence[SolverStats], path: str | Path) -> Path:
+    """Mean step time against N_h per solver, with min..max bars and p99 marks (log scale)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.0, 4.5))
+    for k, name in enumerate(SOLVERS):
+        mine = sorted((r for r in rows if r.solver == name and r.error is None and r.times_ms),
+                      key=lambda r: r.n_humans)
+        if not mine:
+            continue
+        nh = np.array([r.n_humans for r in mine], dtype=float) + (k - 2) * 0.25
+        mean = np.array([r.mean_ms for r in mine])
+        lo = mean - np.array([r.min_ms for r in mine])
+        hi = np.array([r.max_ms for r in mine]) - mean
+        ax.errorbar(nh, mean, yerr=[lo, hi], marker="o", capsize=3, label=name)
+        ax.plot(nh, [r.p99_ms for r in mine], linestyle="none", marker="_", markersize=10, color="black")
+    ax.set_yscale("log")
+    ax.set_xlabel("number of humans N_h")
+    ax.set_ylabel("step time [ms] (mean, min..max, p99 as -)")
+    ax.set_title("Step time against the number of humans")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    p = Path(path)
+    fig.savefig(p, dpi=120)
+    plt.close(fig)
+    return p
+
+
+def _fmt(v: float, digits: int = 3) -> str:
+    if v is None or (isinstance(v, float) and not np.isfinite(v)):
+        return "–"
+    return f"{v:.{digits}g}" if abs(v) < 1e-2 and v != 0 else f"{v:.{digits}f}" if abs(v) < 100 else f"{v:.0f}"
+
+
+def markdown_section(rows: Sequence[SolverStats], machine: dict[str, str], command: str) -> str:
+    lines = [
+        "## Comparison with the references",
+        "",
+        "Same replay for every solver, step by step, each with its own warm start. Step time: humanmpc's own",
+        "timer (prepare + feedback), acados' `time_tot`, Ipopt's `IpoptSolve` (clock_gettime). Iterations:",
+        "QP (interior-point) iterations for humanmpc and acados, NLP iterations for Ipopt. Failures: status",
+        "not 0 (humanmpc, acados: 4 = QP failure, 3 = minimum step) or Ipopt not solved. RCSO: relative",
+        "cumulative sub-optimality against the best Ipopt optimum per step, over the steps the solver solved,",
+        "each plan's controls simulated from the measured state and costed by one common function (see",
+        "`humanmpc.compare`). Violation: the largest d_h - d to a human's current position of a plan the",
+        "solver called solved, over the steps Ipopt found feasible (hard rows are not in the cost).",
+        "",
+        "| N_h | solver | mean ms | min ms | max ms | p99 ms | × ours | iterations (mean/max) | failures | RCSO | "
+        "violation m |",
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for r in rows:
+        if r.error is not None:
+            lines.append(f"| {r.n_humans} | {r.solver} | not run: {r.error.splitlines()[0][:120]} "
+                         "| | | | | | | | |")
+            continue
+        lines.append(
+            f"| {r.n_humans} | {r.solver} | {_fmt(r.mean_ms)} | {_fmt(r.min_ms)} | {_fmt(r.max_ms)} | "
+            f"{_fmt(r.p99_ms)} | {_fmt(r.ratio_to_ours, 2)} | {_fmt(r.iterations_mean, 3)}/{r.iterations_max} | "
+            f"{r.failures}/{r.steps} | {_fmt(r.rcso, 3)} | {_fmt(r.max_violation_m, 3)} |"
+        )
+    lines += [
+        "",
+        "![step time against the number of humans](step_times.png)",
+        "",
+        f"Command: `{command or 'humanmpc-gen bench --compare'}`",
+        "",
+        "Machine: " + ", ".join(f"{k}: {v}" for k, v in machine.items()),
+        "",
+    ]
+    return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------------------------
+# Command line hook (humanmpc-gen bench --compare)
+# ----------------------------------------------------------------------------------------------
+
+
+def add_compare_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of ``humanmpc-gen bench --compare``; run them with ``run_compare_from_args``."""
+    g = parser.add_argument_group("comparison with acados and Ipopt (--compare)")
+    g.add_argument("--compare", action="store_true", help="run humanmpc, acados (2 settings) and Ipopt (cold, warm) "
+                   "on the same replays and write the comparison report")
+    g.add_argument("--compare-specs", nargs="+", type=Path, metavar="SPEC",
+                   help="spec files, one per N_h (default: the built-in spec with N_h = 5, 10, 20, 30)")
+    g.add_argument("--compare-humans", nargs="+", type=int, default=[5, 10, 20, 30], metavar="N_H",
+                   help="N_h of the built-in spec when no --compare-specs are given (default: 5 10 20 30)")
+    g.add_argument("--compare-replays", nargs="+", type=Path, metavar="REPLAY.npz",
+                   help="recorded replays, one per spec (default: synthetic random crowds)")
+    g.add_argument("--compare-steps", type=int, default=100, help="steps of each synthetic replay (default 100)")
+    g.add_argument("--compare-seed", type=int, default=0, help="seed of the synthetic replays (default 0)")
+    g.add_argument("--compare-out", type=Path, default=Path("out/compare"),
+                   help="output folder (default out/compare)")
+    g.add_argument("--compare-skip", nargs="+", default=[], choices=list(SOLVERS), metavar="SOLVER",
+                   help=f"solvers to leave out: {', '.join(repr(s) for s in SOLVERS)}")
+    g.add_argument("--acados-venv", type=Path, default=DEFAULT_ACADOS_VENV,
+                   help="virtualenv for acados (Python 3.12; created when missing; default .venv-acados)")
+
+
+def run_compare_from_args(args: argparse.Namespace) -> int:
+    """Run ``compare`` from parsed arguments; 0 when humanmpc and every available reference ran."""
+    if args.compare_specs:
+        specs: list[Spec | str | Path] = list(args.compare_specs)
+    else:
+        specs = [resolve_spec({"humans": {"max": int(n)}}) for n in args.compare_humans]
+    command = " ".join(["humanmpc-gen" if Path(sys.argv[0]).name == "humanmpc-gen" else "python -m humanmpc.compare",
+                        *sys.argv[1:]])
+    report = compare(specs, args.compare_replays, args.compare_out, steps=args.compare_steps,
+                     seed=args.compare_seed, acados_venv=args.acados_venv, skip=args.compare_skip,
+                     command=command.strip())
+    print((Path(args.compare_out) / "benchmarks.md").read_text())
+    errors = [r for r in report["rows"] if r["error"] and r["solver"] == "humanmpc"]
+    return 1 if errors else 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m humanmpc.compare [options]``: the comparison without the humanmpc-gen hook."""
+    parser = argparse.ArgumentParser(prog="python -m humanmpc.compare",
+                                     description="Compare humanmpc with acados and Ipopt on the same replays.")
+    add_compare_arguments(parser)
+    return run_compare_from_args(parser.parse_args(argv))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

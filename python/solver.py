@@ -1,0 +1,245 @@
+"""The solver object of a loaded package: real-time iteration, full SQP and runtime parameters.
+
+The binding is deliberately thin: the C input and output structs are allocated once per solver,
+numpy arrays view their fields, and a step copies the caller's arrays into those views, makes one
+C call and reads the results back. No cffi object is created per call.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+
+STATUS_NAMES = {0: "solved", 1: "max_iter", 2: "qp_failed"}
+QP_STATUS_NAMES = {0: "solved", 1: "max_iter", 2: "infeasible", 3: "numerical", 4: "nonfinite", 5: "timeout"}
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """What one solver step returns (all arrays are copies: they stay valid after the next step)."""
+
+    u0: FloatArray  # control to apply now: [a, omega]
+    command: FloatArray  # [v after one interval, omega]
+    x: FloatArray  # planned states (N+1, 4)
+    u: FloatArray  # planned controls (N, 2)
+    status: int
+    qp_status: int
+    qp_iterations: int
+    sqp_iterations: int
+    cost: float
+    kkt_stat: float
+    kkt_eq: float
+    kkt_ineq: float
+    kkt_comp: float
+    min_human_distance: float  # over the plan to the humans' current positions (inf: no human)
+    time_prepare_ms: float
+    time_feedback_ms: float
+    time_total_ms: float
+
+    @property
+    def status_name(self) -> str:
+        return STATUS_NAMES.get(self.status, f"unknown({self.status})")
+
+    @property
+    def qp_status_name(self) -> str:
+        return QP_STATUS_NAMES.get(self.qp_status, f"unknown({self.qp_status})")
+
+    @property
+    def kkt(self) -> float:
+        """The largest of the four KKT residuals."""
+        return max(self.kkt_stat, self.kkt_eq, self.kkt_ineq, self.kkt_comp)
+
+
+def _view(ffi: Any, cdata: Any, shape: tuple[int, ...]) -> FloatArray:
+    return np.frombuffer(ffi.buffer(cdata), dtype=np.float64).reshape(shape)
+
+
+class Solver:
+    """A generated solver, loaded with ``humanmpc.load(DIR)``."""
+
+    def __init__(self, name: str, dims: Any, ffi: Any, lib: Any, model: Any, path: Any, spec_hash: str) -> None:
+        self.name = name
+        self.dims = dims
+        self.model = model
+        self.path = path
+        self.spec_hash = spec_hash
+        self._ffi = ffi
+        self._lib = lib
+        fn = lambda suffix: getattr(lib, f"{name}_{suffix}")  # noqa: E731
+        self._c_step = fn("solver_step")
+        self._c_prepare = fn("solver_prepare")
+        self._c_feedback = fn("solver_feedback")
+        self._c_solve = fn("solver_solve")
+        self._c_reset = fn("solver_reset")
+        self._status_message = fn("status_message")
+        self._qp_status_message = fn("qp_status_message")
+        self._mem = ffi.new("char[]", int(fn("solver_memsize")()))
+        self._solver = fn("solver_create")(self._mem)
+        self._params = fn("solver_params")(self._solver)
+        self._in = ffi.new(f"{name}_input *")
+        self._out = ffi.new(f"{name}_output *")
+        N, nh_alloc = dims.N, max(1, dims.nh)
+        self._x0 = _view(ffi, self._in.x0, (4,))
+        self._goal = _view(ffi, self._in.goal, (4,))
+        self._h_now = _view(ffi, self._in.humans_now, (nh_alloc, 2))
+        self._h_pred = _view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2))
+        self._obstacle = _view(ffi, self._in.obstacle, (2,))
+        self._out_x = _view(ffi, self._out.x, (N + 1, 4))
+        self._out_u = _view(ffi, self._out.u, (N, 2))
+        self._out_u0 = _view(ffi, self._out.u0, (2,))
+        self._out_cmd = _view(ffi, self._out.command, (2,))
+        self._param_fields = {f: t.type for f, t in ffi.typeof(f"{name}_params").fields}
+
+    # -- inputs -------------------------------------------------------------------------------
+    def _load_inputs(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None,
+                     humans_pred: ArrayLike | None, obstacle: ArrayLike | None) -> None:
+        N, nh = self.dims.N, self.dims.nh
+        x0a = np.asarray(x0, dtype=np.float64)
+        if x0a.shape != (4,):
+            raise ValueError(f"x0 must have shape (4,) = [px, py, theta, v], got {x0a.shape}")
+        ga = np.asarray(goal, dtype=np.float64)
+        if ga.shape != (4,):
+            raise ValueError(f"goal must have shape (4,) = [gx, gy, gtheta, v_ref], got {ga.shape}")
+        if humans_now is None:
+            now = np.zeros((0, 2))
+        else:
+            now = np.asarray(humans_now, dtype=np.float64)
+            if now.ndim != 2 or now.shape[1] != 2:
+                raise ValueError(f"humans_now must have shape (k, 2), got {now.shape}")
+        k = now.shape[0]
+        if k > nh:
+            raise ValueError(f"{k} humans given but this solver handles at most N_h = {nh}")
+        if humans_pred is None:
+            if k:
+                raise ValueError("humans_pred is required when humans_now holds humans: shape (N+1, k, 2)")
+            pred = np.zeros((N + 1, 0, 2))
+        else:
+            pred = np.asarray(humans_pred, dtype=np.float64)
+            if pred.shape != (N + 1, k, 2):
+                raise ValueError(f"humans_pred must have shape (N+1, k, 2) = ({N + 1}, {k}, 2), got {pred.shape}")
+        self._x0[:] = x0a
+        self._goal[:] = ga
+        self._h_now[:k] = now
+        self._h_pred[:, :k] = pred
+        self._in.n_humans = k
+        if obstacle is None:
+            self._in.has_obstacle = 0
+        else:
+            oa = np.asarray(obstacle, dtype=np.float64)
+            if oa.shape != (2,):
+                raise ValueError(f"obstacle must have shape (2,) = [ox, oy] or be None, got {oa.shape}")
+            self._obstacle[:] = oa
+            self._in.has_obstacle = 1
+
+    def _result(self) -> StepResult:
+        o = self._out
+        return StepResult(
+            u0=self._out_u0.copy(), command=self._out_cmd.copy(), x=self._out_x.copy(), u=self._out_u.copy(),
+            status=o.status, qp_status=o.qp_status, qp_iterations=o.qp_iterations,
+            sqp_iterations=o.sqp_iterations, cost=o.cost, kkt_stat=o.kkt_stat, kkt_eq=o.kkt_eq,
+            kkt_ineq=o.kkt_ineq, kkt_comp=o.kkt_comp, min_human_distance=o.min_human_distance,
+            time_prepare_ms=o.time_prepare_ms, time_feedback_ms=o.time_feedback_ms,
+            time_total_ms=o.time_total_ms,
+        )
+
+    # -- solving ------------------------------------------------------------------------------
+    def step(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None = None,
+             humans_pred: ArrayLike | None = None, obstacle: ArrayLike | None = None) -> StepResult:
+        """One real-time iteration: preparation around the shifted previous plan, then feedback.
+
+        humans_now: (k, 2) current positions, k <= N_h; humans_pred: (N+1, k, 2) predicted
+        positions at the nodes; obstacle: (2,) closest obstacle point or None.
+        """
+        self._load_inputs(x0, goal, humans_now, humans_pred, obstacle)
+        self._c_step(self._solver, self._in, self._out)
+        return self._result()
+
+    def prepare(self, goal: ArrayLike, humans_now: ArrayLike | None = None, humans_pred: ArrayLike | None = None,
+                obstacle: ArrayLike | None = None, x0_guess: ArrayLike | None = None) -> None:
+        """The preparation phase alone (before the measurement): x0_guess is used only on a cold start."""
+        guess = self._x0.copy() if x0_guess is None else x0_guess
+        self._load_inputs(guess, goal, humans_now, humans_pred, obstacle)
+        self._c_prepare(self._solver, self._in)
+
+    def feedback(self, x0: ArrayLike) -> StepResult:
+        """The feedback phase: insert the measured state into the prepared QP and solve it."""
+        x0a = np.asarray(x0, dtype=np.float64)
+        if x0a.shape != (4,):
+            raise ValueError(f"x0 must have shape (4,) = [px, py, theta, v], got {x0a.shape}")
+        self._x0[:] = x0a
+        self._c_feedback(self._solver, self._in, self._out)
+        return self._result()
+
+    def solve(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None = None,
+              humans_pred: ArrayLike | None = None, obstacle: ArrayLike | None = None, *,
+              max_iter: int = 100, tol: float = 1e-8) -> StepResult:
+        """Full SQP to the KKT tolerance, from the current plan (after reset(): a cold start)."""
+        if max_iter < 1:
+            raise ValueError(f"max_iter must be >= 1, got {max_iter}")
+        if not (math.isfinite(tol) and tol > 0):
+            raise ValueError(f"tol must be a positive finite number, got {tol}")
+        self._load_inputs(x0, goal, humans_now, humans_pred, obstacle)
+        self._c_solve(self._solver, self._in, self._out, int(max_iter), float(tol))
+        return self._result()
+
+    def reset(self) -> None:
+        """Forget the previous plan: the next step starts cold. Parameters are kept."""
+        self._c_reset(self._solver)
+
+    # -- parameters ---------------------------------------------------------------------------
+    @property
+    def params(self) -> dict[str, Any]:
+        """The runtime parameters now in force."""
+        out: dict[str, Any] = {}
+        for field, ftype in self._param_fields.items():
+            value = getattr(self._params, field)
+            out[field] = tuple(value) if ftype.kind == "array" else value
+        return out
+
+    def set_params(self, **values: Any) -> None:
+        """Change runtime parameters, e.g. set_params(q=3.0, w_goal=[1, 1, 0, 100]).
+
+        Every value is checked (name, size, finite, sign) before any is written.
+        """
+        staged: list[tuple[str, Any]] = []
+        for key, value in values.items():
+            if key not in self._param_fields:
+                raise KeyError(f"unknown parameter {key!r}; parameters are {', '.join(self._param_fields)}")
+            ftype = self._param_fields[key]
+            if key == "qp_max_iter":
+                if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 10000:
+                    raise ValueError(f"qp_max_iter must be an integer in [1, 10000], got {value!r}")
+                staged.append((key, value))
+                continue
+            arr = np.asarray(value, dtype=np.float64)
+            size = ftype.length if ftype.kind == "array" else 1
+            if arr.size != size:
+                raise ValueError(f"parameter {key} takes {size} value(s), got {arr.size}")
+            if not np.all(np.isfinite(arr)):
+                raise ValueError(f"parameter {key} must be finite, got {value!r}")
+            if key.endswith("_bounds"):
+                if not arr[0] < arr[1]:
+                    raise ValueError(f"parameter {key} must be [lower, upper] with lower < upper, got {value!r}")
+            else:
+                strict = key in ("kappa", "qp_tol", "deadline_ms")
+                if np.any(arr < 0) or (strict and np.any(arr <= 0)):
+                    raise ValueError(f"parameter {key} must be {'> 0' if strict else '>= 0'}, got {value!r}")
+            staged.append((key, arr.tolist() if size > 1 else float(arr.reshape(-1)[0])))
+        for key, v in staged:
+            setattr(self._params, key, v)
+
+    def status_message(self, status: int) -> str:
+        return str(self._ffi.string(self._status_message(status)).decode())
+
+    def qp_status_message(self, status: int) -> str:
+        return str(self._ffi.string(self._qp_status_message(status)).decode())
+
+    def __repr__(self) -> str:
+        d = self.dims
+        return f"<humanmpc.Solver {self.name!r} N={d.N} nh={d.nh} dt={d.dt:g} from {self.path}>"
