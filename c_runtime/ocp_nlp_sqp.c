@@ -9,6 +9,7 @@
  */
 #include "ocp_nlp_sqp.h"
 
+#include "monitor.h"
 #include "ocp_qp.h"
 #include "ocp_qp_ipm.h"
 
@@ -90,6 +91,23 @@ static void ocp_nlp_shift(hm_solver *s, const hm_input *in)
         ocp_nlp_shift_rows(&m->lam_ls[0][0], HM_N + 1, HM_NG);
     }
     ocp_nlp_simulate(s);
+}
+
+/* The safe fallback guess: brake to standstill within the acceleration bound, without turning,
+ * from the measured state. Whenever braking keeps d_h, this guess satisfies every human row, so
+ * the QP linearised at it (zero step feasible, rows convex) returns a plan that keeps d_h too. */
+static void ocp_nlp_init_braking(hm_solver *s, const hm_input *in)
+{
+    const hm_real a_min = s->params.a_bounds[0], a_max = s->params.a_bounds[1];
+    hm_real A[HM_NX * HM_NX], B[HM_NX * HM_NU];
+    int n, i;
+    for (i = 0; i < HM_NX; i++) s->x[0][i] = in->x0[i];
+    for (n = 0; n < HM_N; n++) {
+        s->u[n][0] = hm_fmin(hm_fmax(-s->x[n][3] / HM_R(HM_DT), a_min), a_max);
+        s->u[n][1] = HM_R(0.0);
+        hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], A, B);
+    }
+    ocp_qp_sol_set_zero(&s->mult);
 }
 
 static hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2)
@@ -288,9 +306,14 @@ static void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
 HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in)
 {
     const unsigned long long t0 = ocp_nlp_now(s);
-    ocp_nlp_shift(s, in);
-    ocp_nlp_linearize(s, in, 0);
-    s->prepared = 1;
+    s->prepared = 0;
+    /* Nothing is computed from unusable data; the feedback phase turns it into a stop. A cold
+     * start reads x0 (the caller's guess) already here. */
+    if (monitor_check_params(&s->params) && monitor_check_input(in, !s->warm)) {
+        ocp_nlp_shift(s, in);
+        ocp_nlp_linearize(s, in, 0);
+        s->prepared = 1;
+    }
     s->time_prepare_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
 }
 
@@ -460,6 +483,8 @@ static void ocp_nlp_residuals(hm_solver *s, hm_output *out)
     out->kkt_comp = res.comp;
 }
 
+/* Smallest distance of the robot's path (nodes 0..N of s->x) to the present humans' current
+ * positions, HM_INF without humans. */
 static hm_real ocp_nlp_min_human_distance(const hm_solver *s, const hm_input *in)
 {
     const int nh = ocp_nlp_clamp_humans(in);
@@ -474,6 +499,17 @@ static hm_real ocp_nlp_min_human_distance(const hm_solver *s, const hm_input *in
         }
     }
     return best;
+}
+
+static int ocp_nlp_plan_finite(const hm_solver *s)
+{
+    hm_real acc = HM_R(0.0);
+    int n, i;
+    for (n = 0; n <= HM_N; n++)
+        for (i = 0; i < HM_NX; i++) acc += s->x[n][i] * HM_R(0.0);
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) acc += s->u[n][i] * HM_R(0.0);
+    return acc == HM_R(0.0); /* 0 * x is NaN for NaN or infinite x */
 }
 
 static void ocp_nlp_report(const hm_solver *s, const hm_input *in, hm_output *out)
@@ -491,51 +527,225 @@ static void ocp_nlp_report(const hm_solver *s, const hm_input *in, hm_output *ou
     out->min_human_distance = ocp_nlp_min_human_distance(s, in);
 }
 
+/* Protective stop: brake to standstill within the acceleration bound, no turning; out's plan shows
+ * the braking. Without a usable measured speed the command is the hardest braking. After a failure
+ * (C1, unusable inputs) the next step starts cold, exactly as a fresh solver; after a C2 stop the
+ * plan is kept, so that the next steps go on improving it (a cold start would put the unsafe
+ * straight-line guess back every time). */
+static void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output *out, int reason)
+{
+    const int params_ok = monitor_check_params(&s->params);
+    const hm_real a_min = params_ok ? s->params.a_bounds[0] : HM_R(-1.0);
+    const hm_real a_max = params_ok ? s->params.a_bounds[1] : HM_R(1.0);
+    const int x0_ok = params_ok && monitor_check_input(in, 1);
+    int n, i;
+    out->stop = 1;
+    out->stop_reason = reason;
+    if (!x0_ok) {
+        /* No trustworthy state (or bounds): full braking, a plan of zeros, nothing computed. */
+        for (n = 0; n <= HM_N; n++)
+            for (i = 0; i < HM_NX; i++) out->x[n][i] = HM_R(0.0);
+        for (n = 0; n < HM_N; n++) {
+            out->u[n][0] = a_min;
+            out->u[n][1] = HM_R(0.0);
+        }
+        out->min_human_distance = HM_INF;
+    } else {
+        hm_real A[HM_NX * HM_NX], B[HM_NX * HM_NU];
+        hm_real best = HM_INF;
+        int j;
+        for (i = 0; i < HM_NX; i++) out->x[0][i] = in->x0[i];
+        for (n = 0; n < HM_N; n++) {
+            out->u[n][0] = hm_fmin(hm_fmax(-out->x[n][3] / HM_R(HM_DT), a_min), a_max);
+            out->u[n][1] = HM_R(0.0);
+            hm_model_dynamics(out->x[n], out->u[n], out->x[n + 1], A, B);
+        }
+        for (n = 0; n <= HM_N; n++) {
+            for (j = 0; j < ocp_nlp_clamp_humans(in); j++) {
+                const hm_real dx = out->x[n][0] - in->humans_now[j][0];
+                const hm_real dy = out->x[n][1] - in->humans_now[j][1];
+                best = hm_fmin(best, hm_sqrt(dx * dx + dy * dy));
+            }
+        }
+        out->min_human_distance = best;
+    }
+    out->u0[0] = out->u[0][0];
+    out->u0[1] = HM_R(0.0);
+    out->command[0] = x0_ok ? out->x[1][3] : HM_R(0.0);
+    out->command[1] = HM_R(0.0);
+    s->prepared = 0;
+    if (reason != HM_STOP_UNSAFE_PLAN && reason != HM_STOP_HUMAN_TOO_CLOSE) s->warm = 0;
+}
+
+/* Deadline hook of the QP iterations. */
+static int ocp_nlp_deadline_passed(void *ctx)
+{
+    const hm_solver *s = (const hm_solver *)ctx;
+    return s->clock != 0 && s->clock(s->clock_ctx) - s->t_start > s->deadline_ns;
+}
+
+static void ocp_nlp_start_clock(hm_solver *s, unsigned long long t_start)
+{
+    s->t_start = t_start;
+    s->deadline_ns = (unsigned long long)(s->params.deadline_ms * HM_R(1e6));
+}
+
+static void ocp_nlp_clear_output(hm_output *out)
+{
+    out->stop = 0;
+    out->stop_reason = HM_STOP_NONE;
+    out->status = HM_STATUS_SKIPPED;
+    out->qp_status = -1;
+    out->qp_iterations = 0;
+    out->sqp_iterations = 0;
+    out->cost = HM_R(0.0);
+    out->kkt_stat = HM_R(0.0);
+    out->kkt_eq = HM_R(0.0);
+    out->kkt_ineq = HM_R(0.0);
+    out->kkt_comp = HM_R(0.0);
+    out->min_human_distance = HM_INF;
+}
+
+/* The checks that come before any solving; returns the stop reason or HM_STOP_NONE. */
+static int ocp_nlp_check_before(const hm_solver *s, const hm_input *in)
+{
+    if (!monitor_check_params(&s->params)) return HM_STOP_INVALID_PARAMS;
+    if (!monitor_check_input(in, 1)) return HM_STOP_INVALID_INPUT;
+    if (monitor_distance_now(in) < s->params.d_h) return HM_STOP_HUMAN_TOO_CLOSE;
+    return HM_STOP_NONE;
+}
+
+static int ocp_nlp_keeps_distance(const hm_real *x, const hm_input *in, hm_real limit)
+{
+    const int nh = ocp_nlp_clamp_humans(in);
+    int j;
+    for (j = 0; j < nh; j++) {
+        const hm_real dx = x[0] - in->humans_now[j][0];
+        const hm_real dy = x[1] - in->humans_now[j][1];
+        if (dx * dx + dy * dy < limit * limit) return 0;
+    }
+    return 1;
+}
+
+/* C2 on the plan: its nodes 1..N against the humans' current positions, and the state the robot
+ * really reaches after applying u0 for one interval (the model from the measured x0: the plan's
+ * own x_1 is the QP's linear prediction of it). The allowance covers the distance smoothing
+ * (eps^2 / (2 d_h) ~ 1e-6 m) and the QP tolerance. */
+static int ocp_nlp_check_plan(const hm_solver *s, const hm_input *in)
+{
+    const hm_real limit = s->params.d_h - HM_R(1e-5);
+    hm_real x1[HM_NX], A[HM_NX * HM_NX], B[HM_NX * HM_NU];
+    int n;
+    if (!ocp_nlp_plan_finite(s)) return HM_STOP_NONFINITE;
+    for (n = 1; n <= HM_N; n++)
+        if (!ocp_nlp_keeps_distance(s->x[n], in, limit)) return HM_STOP_UNSAFE_PLAN;
+    hm_model_dynamics(in->x0, s->u[0], x1, A, B);
+    if (!ocp_nlp_keeps_distance(x1, in, limit)) return HM_STOP_UNSAFE_PLAN;
+    return HM_STOP_NONE;
+}
+
+static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output *out, unsigned long long t_start)
+{
+    unsigned long long t_feedback;
+    int qp_status, status, reason;
+    ocp_nlp_start_clock(s, t_start);
+    ocp_nlp_clear_output(out);
+    out->sqp_iterations = 1;
+    reason = ocp_nlp_check_before(s, in);
+    if (reason == HM_STOP_NONE) {
+        if (!s->prepared) ocp_nlp_sqp_rti_prepare(s, in);
+        t_feedback = ocp_nlp_now(s);
+        if (!s->warm) ocp_qp_sol_set_zero(&s->mult);
+        ocp_nlp_set_x0(s, in);
+        s->ipm_arg.should_stop = ocp_nlp_deadline_passed;
+        s->ipm_arg.stop_ctx = s;
+        qp_status = ocp_nlp_qp_step(s, &out->qp_iterations);
+        s->ipm_arg.should_stop = 0;
+        s->ipm_arg.stop_ctx = 0;
+        /* With the multipliers of this QP: how far the linearisation point is from a KKT point. */
+        ocp_nlp_residuals(s, out);
+        s->prepared = 0;
+        out->qp_status = qp_status;
+        status = qp_status == HM_QP_SOLVED ? HM_STATUS_OK
+                 : qp_status == HM_QP_MAX_ITER ? HM_STATUS_MAX_ITER : HM_STATUS_QP_FAILED;
+        out->status = status;
+        if (qp_status == HM_QP_TIMEOUT) {
+            reason = HM_STOP_DEADLINE;
+        } else if (qp_status != HM_QP_SOLVED) {
+            reason = HM_STOP_QP_FAILED;  /* the iteration limit too: not a solution */
+        } else {
+            reason = ocp_nlp_check_plan(s, in);
+            if (reason == HM_STOP_UNSAFE_PLAN) {
+                /* The warm start led the plan between humans it cannot pass (a local solution in
+                 * the wrong homotopy class). Solve once more from the braking guess, which keeps
+                 * d_h whenever braking does. */
+                out->sqp_iterations = 2;
+                ocp_nlp_init_braking(s, in);
+                ocp_nlp_linearize(s, in, 0);
+                ocp_nlp_set_x0(s, in);
+                s->ipm_arg.should_stop = ocp_nlp_deadline_passed;
+                s->ipm_arg.stop_ctx = s;
+                qp_status = ocp_nlp_qp_step(s, &out->qp_iterations);
+                s->ipm_arg.should_stop = 0;
+                s->ipm_arg.stop_ctx = 0;
+                ocp_nlp_residuals(s, out);
+                out->qp_status = qp_status;
+                out->status = qp_status == HM_QP_SOLVED ? HM_STATUS_OK
+                              : qp_status == HM_QP_MAX_ITER ? HM_STATUS_MAX_ITER : HM_STATUS_QP_FAILED;
+                reason = qp_status == HM_QP_TIMEOUT ? HM_STOP_DEADLINE
+                         : qp_status != HM_QP_SOLVED ? HM_STOP_QP_FAILED : ocp_nlp_check_plan(s, in);
+            }
+            if (reason == HM_STOP_NONE && ocp_nlp_deadline_passed(s)) reason = HM_STOP_DEADLINE;
+        }
+    } else {
+        s->prepared = 0;
+        t_feedback = ocp_nlp_now(s);
+    }
+    if (reason == HM_STOP_NONE || reason == HM_STOP_UNSAFE_PLAN) s->warm = 1;
+    if (reason == HM_STOP_NONE) {
+        ocp_nlp_report(s, in, out);
+    } else {
+        ocp_nlp_protective_stop(s, in, out, reason);
+    }
+    out->time_prepare_ms = s->time_prepare_ms;
+    out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t_feedback);
+    out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t_start);
+    return out->status;
+}
+
+/* Feedback after a separate preparation: the deadline counts from here. */
 HM_FUNC int ocp_nlp_sqp_rti_feedback(hm_solver *s, const hm_input *in, hm_output *out)
 {
-    unsigned long long t0;
-    int qp_status, status;
-    if (!s->prepared) ocp_nlp_sqp_rti_prepare(s, in);
-    t0 = ocp_nlp_now(s);
-    out->qp_iterations = 0;
-    if (!s->warm) ocp_qp_sol_set_zero(&s->mult);
-    ocp_nlp_set_x0(s, in);
-    qp_status = ocp_nlp_qp_step(s, &out->qp_iterations);
-    /* With the multipliers of this QP: how far the linearisation point is from a KKT point. */
-    ocp_nlp_residuals(s, out);
-    s->prepared = 0;
-    if (qp_status == HM_QP_SOLVED) {
-        status = HM_STATUS_OK;
-    } else if (qp_status == HM_QP_MAX_ITER) {
-        status = HM_STATUS_MAX_ITER;
-    } else {
-        /* No usable step: start the next one from a cold guess rather than from a plan that the
-         * QP could not improve (a failed QP tends to stay failed when warm started from it). */
-        status = HM_STATUS_QP_FAILED;
-        s->warm = 0;
-    }
-    if (status != HM_STATUS_QP_FAILED) s->warm = 1;
-    out->status = status;
-    out->qp_status = qp_status;
-    out->sqp_iterations = 1;
-    ocp_nlp_report(s, in, out);
-    out->time_prepare_ms = s->time_prepare_ms;
-    out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
-    out->time_total_ms = out->time_prepare_ms + out->time_feedback_ms;
-    return status;
+    if (!s->prepared) s->time_prepare_ms = HM_R(0.0);
+    return ocp_nlp_rti_feedback_from(s, in, out, ocp_nlp_now(s));
+}
+
+/* A whole real-time iteration: the deadline counts from the start of the preparation. */
+HM_FUNC int ocp_nlp_sqp_rti_step(hm_solver *s, const hm_input *in, hm_output *out)
+{
+    const unsigned long long t0 = ocp_nlp_now(s);
+    ocp_nlp_sqp_rti_prepare(s, in);
+    return ocp_nlp_rti_feedback_from(s, in, out, t0);
 }
 
 HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol)
 {
     const unsigned long long t0 = ocp_nlp_now(s);
-    int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER;
+    int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER, reason;
+    ocp_nlp_clear_output(out);
+    reason = ocp_nlp_check_before(s, in);
+    if (reason != HM_STOP_NONE) {
+        ocp_nlp_protective_stop(s, in, out, reason);
+        out->time_total_ms = out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
+        out->time_prepare_ms = HM_R(0.0);
+        return out->status;
+    }
     if (!s->warm) {
         ocp_nlp_shift(s, in); /* cold: controls held at zero from x0 */
         ocp_qp_sol_set_zero(&s->mult);
         s->warm = 1;
     }
     s->merit_mu = HM_R(1.0);
-    out->qp_iterations = 0;
     for (k = 0; k < max_iter; k++) {
         ocp_nlp_linearize(s, in, k > 0);
         ocp_nlp_set_x0(s, in);
@@ -547,7 +757,6 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
         qp_status = ocp_nlp_qp_line_search_step(s, in, tol, &out->qp_iterations);
         if (!ocp_nlp_qp_usable(qp_status)) {
             status = HM_STATUS_QP_FAILED;
-            s->warm = 0;
             break;
         }
     }
@@ -563,7 +772,16 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
     out->status = status;
     out->qp_status = qp_status;
     out->sqp_iterations = k;
-    ocp_nlp_report(s, in, out);
+    reason = HM_STOP_NONE;
+    if (status == HM_STATUS_QP_FAILED) {
+        reason = HM_STOP_QP_FAILED;
+    } else {
+        reason = ocp_nlp_check_plan(s, in);
+    }
+    if (reason == HM_STOP_NONE)
+        ocp_nlp_report(s, in, out);
+    else
+        ocp_nlp_protective_stop(s, in, out, reason);
     out->time_prepare_ms = HM_R(0.0);
     out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
     out->time_total_ms = out->time_feedback_ms;
@@ -579,6 +797,8 @@ HM_FUNC const char *ocp_nlp_status_message(int status)
         return "iteration limit reached before the tolerance";
     case HM_STATUS_QP_FAILED:
         return "the QP failed; no step taken";
+    case HM_STATUS_SKIPPED:
+        return "nothing solved: a protective stop was decided before solving";
     default:
         return "unknown status";
     }

@@ -23,6 +23,8 @@
 #include "hm_common.h"
 #include "hm_timing.h"
 
+/* HM_DT: the interval length, from the including translation unit. */
+
 typedef HM_NS(params) hm_params;
 typedef HM_NS(input) hm_input;
 typedef HM_NS(output) hm_output;
@@ -33,13 +35,15 @@ typedef HM_NS(solver) hm_solver;
 enum hm_status {
     HM_STATUS_OK = 0,        /* RTI: QP solved, step taken. Full SQP: converged to the tolerance */
     HM_STATUS_MAX_ITER = 1,  /* RTI: QP stopped at its iteration limit (step taken). SQP: not converged */
-    HM_STATUS_QP_FAILED = 2  /* the QP failed (see qp_status): no step taken, next step starts cold */
+    HM_STATUS_QP_FAILED = 2, /* the QP failed (see qp_status): no step taken, next step starts cold */
+    HM_STATUS_SKIPPED = 3    /* nothing solved: inputs unusable or a human already too close (see stop) */
 };
 
 HM_FUNC void ocp_nlp_sqp_init(hm_solver *s, const hm_params *params);
 HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s);
 HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in);
 HM_FUNC int ocp_nlp_sqp_rti_feedback(hm_solver *s, const hm_input *in, hm_output *out);
+HM_FUNC int ocp_nlp_sqp_rti_step(hm_solver *s, const hm_input *in, hm_output *out);
 HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol);
 HM_FUNC const char *ocp_nlp_status_message(int status);
 

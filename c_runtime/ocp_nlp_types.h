@@ -32,4 +32,6 @@ typedef struct HM_NS(solver) {
     HM_REAL time_prepare_ms;
     HM_NS(clock_fn) clock;
     void *clock_ctx;
+    unsigned long long t_start;      /* clock reading at the start of the step (deadline origin) */
+    unsigned long long deadline_ns;
 } HM_NS(solver);

@@ -9,14 +9,27 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+if TYPE_CHECKING:
+    from .steplog import StepLog
+
 FloatArray = NDArray[np.float64]
 
-STATUS_NAMES = {0: "solved", 1: "max_iter", 2: "qp_failed"}
+STATUS_NAMES = {0: "solved", 1: "max_iter", 2: "qp_failed", 3: "skipped"}
+STOP_REASONS = {
+    0: None,
+    1: "invalid_input",
+    2: "invalid_params",
+    3: "deadline",
+    4: "qp_failed",
+    5: "nonfinite",
+    6: "human_too_close",
+    7: "unsafe_plan",
+}
 QP_STATUS_NAMES = {0: "solved", 1: "max_iter", 2: "infeasible", 3: "numerical", 4: "nonfinite", 5: "timeout"}
 
 
@@ -24,6 +37,8 @@ QP_STATUS_NAMES = {0: "solved", 1: "max_iter", 2: "infeasible", 3: "numerical", 
 class StepResult:
     """What one solver step returns (all arrays are copies: they stay valid after the next step)."""
 
+    stop: bool  # a protective stop is in force: u0 brakes to standstill without turning
+    stop_reason: int  # 0 none; see STOP_REASONS and reason
     u0: FloatArray  # control to apply now: [a, omega]
     command: FloatArray  # [v after one interval, omega]
     x: FloatArray  # planned states (N+1, 4)
@@ -41,6 +56,11 @@ class StepResult:
     time_prepare_ms: float
     time_feedback_ms: float
     time_total_ms: float
+
+    @property
+    def reason(self) -> str | None:
+        """Why the stop is in force (None without a stop): one of the names in STOP_REASONS."""
+        return STOP_REASONS.get(self.stop_reason, f"unknown({self.stop_reason})")
 
     @property
     def status_name(self) -> str:
@@ -79,6 +99,7 @@ class Solver:
         self._c_reset = fn("solver_reset")
         self._status_message = fn("status_message")
         self._qp_status_message = fn("qp_status_message")
+        self._stop_reason_message = fn("stop_reason_message")
         self._mem = ffi.new("char[]", int(fn("solver_memsize")()))
         self._solver = fn("solver_create")(self._mem)
         self._params = fn("solver_params")(self._solver)
@@ -95,6 +116,14 @@ class Solver:
         self._out_u0 = _view(ffi, self._out.u0, (2,))
         self._out_cmd = _view(ffi, self._out.command, (2,))
         self._param_fields = {f: t.type for f, t in ffi.typeof(f"{name}_params").fields}
+        self.log: StepLog | None = None
+
+    def start_log(self, capacity: int = 10000) -> StepLog:
+        """Keep the newest `capacity` steps (status, stop reason, timings, closest human) in self.log."""
+        from .steplog import StepLog
+
+        self.log = StepLog(capacity)
+        return self.log
 
     # -- inputs -------------------------------------------------------------------------------
     def _load_inputs(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None,
@@ -139,7 +168,8 @@ class Solver:
 
     def _result(self) -> StepResult:
         o = self._out
-        return StepResult(
+        r = StepResult(
+            stop=bool(o.stop), stop_reason=o.stop_reason,
             u0=self._out_u0.copy(), command=self._out_cmd.copy(), x=self._out_x.copy(), u=self._out_u.copy(),
             status=o.status, qp_status=o.qp_status, qp_iterations=o.qp_iterations,
             sqp_iterations=o.sqp_iterations, cost=o.cost, kkt_stat=o.kkt_stat, kkt_eq=o.kkt_eq,
@@ -147,6 +177,9 @@ class Solver:
             time_prepare_ms=o.time_prepare_ms, time_feedback_ms=o.time_feedback_ms,
             time_total_ms=o.time_total_ms,
         )
+        if self.log is not None:
+            self.log.append(r)
+        return r
 
     # -- solving ------------------------------------------------------------------------------
     def step(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None = None,
@@ -236,6 +269,9 @@ class Solver:
 
     def status_message(self, status: int) -> str:
         return str(self._ffi.string(self._status_message(status)).decode())
+
+    def stop_reason_message(self, reason: int) -> str:
+        return str(self._ffi.string(self._stop_reason_message(reason)).decode())
 
     def qp_status_message(self, status: int) -> str:
         return str(self._ffi.string(self._qp_status_message(status)).decode())

@@ -1,0 +1,114 @@
+/*
+ * monitor.c: input and parameter checks and the distance checks of the safety monitor
+ * (see monitor.h). The protective stop itself and the C1/C2 decisions are in ocp_nlp_sqp.c, where
+ * the solver's state is.
+ */
+#include "monitor.h"
+
+static int monitor_finite(hm_real v)
+{
+    /* v - v is 0 for finite v and NaN for NaN or infinity; no isfinite(), which C99 freestanding
+     * targets may lack for float. */
+    return (v - v) == (v - v);
+}
+
+static int monitor_position_ok(const hm_real *p)
+{
+    return monitor_finite(p[0]) && monitor_finite(p[1]) && hm_fabs(p[0]) <= HM_MONITOR_MAX_POSITION &&
+           hm_fabs(p[1]) <= HM_MONITOR_MAX_POSITION;
+}
+
+static int monitor_state_ok(const hm_real *x)
+{
+    return monitor_position_ok(x) && monitor_finite(x[2]) && monitor_finite(x[3]) &&
+           hm_fabs(x[2]) <= HM_MONITOR_MAX_ANGLE && hm_fabs(x[3]) <= HM_MONITOR_MAX_SPEED;
+}
+
+/* 1 when every input that takes part in the step is usable. check_x0 = 0 for the preparation
+ * phase, which runs before the measurement. Entries of absent humans are not read. */
+HM_FUNC int monitor_check_input(const hm_input *in, int check_x0)
+{
+    int n, j;
+    if (check_x0 && !monitor_state_ok(in->x0)) return 0;
+    if (!monitor_state_ok(in->goal)) return 0;
+    if (in->n_humans < 0 || in->n_humans > HM_NG - 1) return 0;
+    if (in->has_obstacle != 0 && in->has_obstacle != 1) return 0;
+    if (in->has_obstacle && !monitor_position_ok(in->obstacle)) return 0;
+    for (j = 0; j < in->n_humans; j++) {
+        if (!monitor_position_ok(in->humans_now[j])) return 0;
+        for (n = 0; n <= HM_N; n++)
+            if (!monitor_position_ok(in->humans_pred[n][j])) return 0;
+    }
+    return 1;
+}
+
+static int monitor_nonneg(hm_real v)
+{
+    return monitor_finite(v) && v >= HM_R(0.0);
+}
+
+static int monitor_interval_ok(const hm_real *b)
+{
+    /* lower < upper and 0 inside: the protective stop must be feasible */
+    return monitor_finite(b[0]) && monitor_finite(b[1]) && b[0] < b[1] && b[0] <= HM_R(0.0) && b[1] >= HM_R(0.0);
+}
+
+/* 1 when the runtime parameters are usable (the rules of the spec). */
+HM_FUNC int monitor_check_params(const hm_params *p)
+{
+    int i;
+    for (i = 0; i < HM_NX; i++)
+        if (!monitor_nonneg(p->w_goal[i]) || !monitor_nonneg(p->w_goal_terminal[i])) return 0;
+    for (i = 0; i < HM_NU; i++)
+        if (!monitor_nonneg(p->w_control[i])) return 0;
+    if (!monitor_nonneg(p->q) || !monitor_nonneg(p->d_th) || !monitor_nonneg(p->d_h) || !monitor_nonneg(p->d_s))
+        return 0;
+    if (!monitor_finite(p->kappa) || p->kappa <= HM_R(0.0) || p->kappa > HM_R(1e3)) return 0;
+    if (!monitor_nonneg(p->slack_l1) || !monitor_nonneg(p->slack_l2)) return 0;
+    if (!monitor_nonneg(p->human_slack_l1) || !monitor_nonneg(p->human_slack_l2)) return 0;
+    if (!monitor_interval_ok(p->v_bounds) || !monitor_interval_ok(p->a_bounds) || !monitor_interval_ok(p->omega_bounds))
+        return 0;
+    if (!monitor_nonneg(p->regularization)) return 0;
+    if (!monitor_finite(p->qp_tol) || p->qp_tol <= HM_R(0.0)) return 0;
+    if (!monitor_finite(p->deadline_ms) || p->deadline_ms <= HM_R(0.0)) return 0;
+    if (p->qp_max_iter < 1 || p->qp_max_iter > 1000) return 0;
+    return 1;
+}
+
+/* Distance from the robot now to the closest present human (HM_INF when none). */
+HM_FUNC hm_real monitor_distance_now(const hm_input *in)
+{
+    hm_real best = HM_INF;
+    int j;
+    for (j = 0; j < in->n_humans; j++) {
+        const hm_real dx = in->x0[0] - in->humans_now[j][0];
+        const hm_real dy = in->x0[1] - in->humans_now[j][1];
+        const hm_real d = hm_sqrt(dx * dx + dy * dy);
+        if (d < best) best = d;
+    }
+    return best;
+}
+
+HM_FUNC const char *monitor_stop_reason_message(int reason)
+{
+    switch (reason) {
+    case HM_STOP_NONE:
+        return "no stop";
+    case HM_STOP_INVALID_INPUT:
+        return "protective stop: non-finite or absurd input (state, goal, humans, predictions or obstacle)";
+    case HM_STOP_INVALID_PARAMS:
+        return "protective stop: runtime parameters non-finite or out of range";
+    case HM_STOP_DEADLINE:
+        return "protective stop (C1): the solver missed its deadline";
+    case HM_STOP_QP_FAILED:
+        return "protective stop (C1): the QP was not solved";
+    case HM_STOP_NONFINITE:
+        return "protective stop (C1): non-finite number in the solution";
+    case HM_STOP_HUMAN_TOO_CLOSE:
+        return "protective stop (C2): a human is within d_h of the robot";
+    case HM_STOP_UNSAFE_PLAN:
+        return "protective stop (C2): the planned path comes within d_h of a human";
+    default:
+        return "unknown stop reason";
+    }
+}

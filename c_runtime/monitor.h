@@ -1,0 +1,47 @@
+/*
+ * monitor.h: the feasibility and safety monitors of the paper (section "Feasibility and Safety
+ * Monitors") and the protective stop they command (ISO 3691-4, ISO 13482).
+ *
+ *   inputs  non-finite or absurd state, goal, humans, predictions, obstacle or parameters: nothing is
+ *           computed from them.
+ *   C1      the solver did not return a usable solution in time: the deadline passed (checked inside
+ *           the QP iterations, not only around them), the QP was not solved (iteration limit,
+ *           infeasible, numerical failure) or the solution holds a non-finite number.
+ *   C2      the solution is not safe: the robot already is within d_h of a present human, or the
+ *           planned path comes within d_h of a present human's current position (its nodes 1..N,
+ *           and the state reached by applying u0 from the measured state, by the model).
+ *
+ * A protective stop brakes to standstill within the acceleration bound, without turning. After any
+ * stop the solver starts the next step cold, so it recovers by itself once the situation clears and
+ * gives then exactly what a fresh solver gives.
+ */
+#ifndef HM_MONITOR_H
+#define HM_MONITOR_H
+
+#include "hm_common.h"
+#include "ocp_nlp_sqp.h" /* hm_input, hm_params */
+
+/* Why a protective stop is in force. Fixed values: part of the public C and Python API. */
+enum hm_stop_reason {
+    HM_STOP_NONE = 0,
+    HM_STOP_INVALID_INPUT = 1,    /* non-finite or absurd state, goal, humans, predictions or obstacle */
+    HM_STOP_INVALID_PARAMS = 2,   /* runtime parameters non-finite or out of range */
+    HM_STOP_DEADLINE = 3,         /* C1: the step did not finish within deadline_ms */
+    HM_STOP_QP_FAILED = 4,        /* C1: the QP was not solved (limit, infeasible, numerical failure) */
+    HM_STOP_NONFINITE = 5,        /* C1: a non-finite number in the solution */
+    HM_STOP_HUMAN_TOO_CLOSE = 6,  /* C2: the robot already is within d_h of a human */
+    HM_STOP_UNSAFE_PLAN = 7       /* C2: the planned path comes within d_h of a human's current position */
+};
+#define HM_STOP_REASON_COUNT 8
+
+/* Magnitudes beyond which an input is absurd rather than merely unusual. */
+#define HM_MONITOR_MAX_POSITION HM_R(1.0e5)   /* m */
+#define HM_MONITOR_MAX_ANGLE HM_R(1.0e4)      /* rad: headings may wind, but not without bound */
+#define HM_MONITOR_MAX_SPEED HM_R(100.0)      /* m/s */
+
+HM_FUNC int monitor_check_input(const hm_input *in, int check_x0);
+HM_FUNC int monitor_check_params(const hm_params *p);
+HM_FUNC hm_real monitor_distance_now(const hm_input *in);
+HM_FUNC const char *monitor_stop_reason_message(int reason);
+
+#endif /* HM_MONITOR_H */

@@ -1,0 +1,171 @@
+/*
+ * closed_loop.c: a generated solver driven in C, in a changing random crowd, checking the safety
+ * invariants at every step. Used for the sanitizer builds, the valgrind memcheck run and the soak.
+ *
+ * Build: cc -DSOLVER_HEADER='"soak.h"' -DSOLVER_PREFIX=soak_ -I<dir> closed_loop.c <dir>/soak.c
+ *        <dir>/soak_model.c -lm
+ * Run:   ./closed_loop STEPS SEED DEADLINE_MS
+ * Every step: the command is finite; a stop has a reason and no other step has one; whenever the
+ * robot is within d_h of a present human a stop is in force; a step without a stop solved its QP.
+ * Now and then a NaN is injected into one input (and must give a stop). Prints the counts per stop
+ * reason; the exit status is the number of violated invariants (capped), 0 when none.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include SOLVER_HEADER
+
+#define CAT_(a, b) a##b
+#define CAT(a, b) CAT_(a, b)
+#define S(x) CAT(SOLVER_PREFIX, x)
+
+#define NH_ALLOC ((int)(sizeof(((S(input) *)0)->humans_now) / sizeof(((S(input) *)0)->humans_now[0])))
+#define NNODES ((int)(sizeof(((S(output) *)0)->x) / sizeof(((S(output) *)0)->x[0])))
+#define DT 0.1
+#define N_REASONS 8
+
+static S(solver) solver; /* all memory of the solver, placed statically */
+static S(input) in;
+static S(output) out;
+
+static unsigned long long rng_state;
+
+static double uniform(double lo, double hi)
+{
+    rng_state = rng_state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return lo + (hi - lo) * (double)(rng_state >> 11) / 9007199254740992.0;
+}
+
+static double pos[64][2], vel[64][2];
+
+static void spawn(int j, const double *robot)
+{
+    do {
+        pos[j][0] = uniform(-1.0, 13.0);
+        pos[j][1] = uniform(-5.0, 5.0);
+    } while (hypot(pos[j][0] - robot[0], pos[j][1] - robot[1]) < 2.0);
+    {
+        const double speed = uniform(0.2, 1.3), heading = uniform(-3.14159, 3.14159);
+        vel[j][0] = speed * cos(heading);
+        vel[j][1] = speed * sin(heading);
+    }
+}
+
+static double wrap(double v, double lo, double hi)
+{
+    const double w = hi - lo;
+    while (v < lo) v += w;
+    while (v >= hi) v -= w;
+    return v;
+}
+
+int main(int argc, char **argv)
+{
+    const long steps = argc > 1 ? atol(argv[1]) : 1000;
+    const double deadline_ms = argc > 3 ? atof(argv[3]) : 20.0;
+    long t, counts[N_REASONS] = {0}, violations = 0, injected = 0;
+    double x[4] = {0.0, 0.0, 0.0, 0.0}, goal[2][2] = {{12.0, 0.0}, {0.0, 0.0}}, worst_ms = 0.0;
+    double closest = 1e9;
+    int k = NH_ALLOC < 5 ? NH_ALLOC : 5, g = 0, j, n;
+    rng_state = (unsigned long long)(argc > 2 ? atol(argv[2]) : 1) * 2654435761ULL + 1ULL;
+    if (NH_ALLOC > 64) return 100;
+    S(solver_init)(&solver);
+    S(solver_params)(&solver)->deadline_ms = deadline_ms;
+    for (j = 0; j < NH_ALLOC; j++) spawn(j, x);
+
+    for (t = 0; t < steps; t++) {
+        double d_goal, d_now = 1e9;
+        int inject = 0;
+        if (t % 200 == 199) { /* the crowd changes: another size, some newcomers */
+            k = (int)uniform(0.0, (double)NH_ALLOC + 0.999);
+            for (j = 0; j < NH_ALLOC; j++)
+                if (uniform(0.0, 1.0) < 0.3) spawn(j, x);
+        }
+        d_goal = hypot(goal[g][0] - x[0], goal[g][1] - x[1]);
+        if (d_goal < 0.3) {
+            g = 1 - g;
+            d_goal = hypot(goal[g][0] - x[0], goal[g][1] - x[1]);
+        }
+        memset(&in, 0, sizeof in);
+        for (j = 0; j < 4; j++) in.x0[j] = x[j];
+        in.goal[0] = goal[g][0];
+        in.goal[1] = goal[g][1];
+        in.goal[2] = 0.0;
+        in.goal[3] = d_goal * 0.5 < 0.8 ? d_goal * 0.5 : 0.8;
+        in.n_humans = k;
+        for (j = 0; j < k; j++) {
+            in.humans_now[j][0] = pos[j][0];
+            in.humans_now[j][1] = pos[j][1];
+            for (n = 0; n < NNODES; n++) {
+                in.humans_pred[n][j][0] = pos[j][0] + vel[j][0] * DT * n;
+                in.humans_pred[n][j][1] = pos[j][1] + vel[j][1] * DT * n;
+            }
+            d_now = fmin(d_now, hypot(pos[j][0] - x[0], pos[j][1] - x[1]));
+        }
+        {
+            const double cx = 6.0, cy = 0.9, r = 0.3, dx = x[0] - cx, dy = x[1] - cy, dn = hypot(dx, dy);
+            in.has_obstacle = 1;
+            in.obstacle[0] = cx + (dn > 1e-9 ? dx / dn : 1.0) * r;
+            in.obstacle[1] = cy + (dn > 1e-9 ? dy / dn : 0.0) * r;
+        }
+        if (t % 997 == 500) { /* a sensor glitch */
+            inject = 1;
+            injected++;
+            if (k > 0 && uniform(0.0, 1.0) < 0.5)
+                in.humans_pred[(int)uniform(0.0, NNODES - 0.001)][0][1] = NAN;
+            else
+                in.x0[(int)uniform(0.0, 3.999)] = NAN;
+        }
+
+        S(solver_step)(&solver, &in, &out);
+
+        if (!isfinite(out.u0[0]) || !isfinite(out.u0[1]) || !isfinite(out.command[0]) ||
+            !isfinite(out.command[1])) {
+            fprintf(stderr, "step %ld: non-finite command\n", t);
+            violations++;
+        }
+        if ((out.stop != 0) != (out.stop_reason != 0) || out.stop_reason < 0 || out.stop_reason >= N_REASONS) {
+            fprintf(stderr, "step %ld: stop %d with reason %d\n", t, out.stop, out.stop_reason);
+            violations++;
+        }
+        if (d_now < S(solver_params)(&solver)->d_h && !out.stop) {
+            fprintf(stderr, "step %ld: a human %.3f m away and no stop\n", t, d_now);
+            violations++;
+        }
+        if (inject && out.stop_reason != 1) {
+            fprintf(stderr, "step %ld: injected NaN gave reason %d\n", t, out.stop_reason);
+            violations++;
+        }
+        if (!out.stop && out.qp_status != 0) {
+            fprintf(stderr, "step %ld: no stop but QP status %d\n", t, out.qp_status);
+            violations++;
+        }
+        if (out.stop_reason >= 0 && out.stop_reason < N_REASONS) counts[out.stop_reason]++;
+        if (out.time_total_ms > worst_ms) worst_ms = out.time_total_ms;
+        closest = fmin(closest, d_now);
+
+        { /* the plant: the unicycle under the command, finely integrated */
+            int sub;
+            for (sub = 0; sub < 10; sub++) {
+                const double h = DT / 10.0;
+                x[0] += h * x[3] * cos(x[2]);
+                x[1] += h * x[3] * sin(x[2]);
+                x[2] += h * out.u0[1];
+                x[3] += h * out.u0[0];
+            }
+        }
+        for (j = 0; j < NH_ALLOC; j++) {
+            pos[j][0] = wrap(pos[j][0] + vel[j][0] * DT, -1.0, 13.0);
+            pos[j][1] = wrap(pos[j][1] + vel[j][1] * DT, -5.0, 5.0);
+        }
+    }
+    printf("{\"steps\": %ld, \"violations\": %ld, \"injected\": %ld, \"worst_ms\": %.3f, \"closest\": %.3f, "
+           "\"stops\": {",
+           steps, violations, injected, worst_ms, closest);
+    for (j = 1; j < N_REASONS; j++)
+        printf("\"%s\": %ld%s", S(stop_reason_message)(j), counts[j], j + 1 < N_REASONS ? ", " : "");
+    printf("}, \"no_stop\": %ld}\n", counts[0]);
+    return violations > 100 ? 100 : (int)violations;
+}

@@ -1,0 +1,90 @@
+"""The generated solver's step in C under sanitizers, valgrind, libFuzzer and a 100,000-step soak."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import humanmpc
+
+from .conftest import make_solver, require_tool
+
+C_DIR = Path(__file__).resolve().parent / "c"
+STRICT = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"]
+SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer", "-g"]
+
+
+@pytest.fixture(scope="module")
+def soak_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return make_solver(tmp_path_factory.mktemp("soak"), {"name": "soak"}, built=False)
+
+
+def build_closed_loop(solver_dir: Path, out: Path, cc: str, flags: list[str]) -> Path:
+    name = solver_dir.name
+    cmd = [require_tool(cc), *STRICT, *flags, f'-DSOLVER_HEADER="{name}.h"', f"-DSOLVER_PREFIX={name}_",
+           "-I", str(solver_dir), str(C_DIR / "closed_loop.c"), str(solver_dir / f"{name}.c"),
+           str(solver_dir / f"{name}_model.c"), "-lm", "-o", str(out)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def run_closed_loop(cmd: list[str], timeout: float) -> dict:
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, check=False)
+    assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stderr[-4000:]}"
+    summary = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert summary["violations"] == 0
+    return summary
+
+
+@pytest.mark.parametrize("cc", ["gcc", "clang"])
+def test_closed_loop_is_clean_under_address_and_undefined_sanitizers(soak_dir: Path, tmp_path: Path,
+                                                                    cc: str) -> None:
+    exe = build_closed_loop(soak_dir, tmp_path / f"loop_{cc}", cc, ["-O1", *SANITIZE])
+    summary = run_closed_loop([str(exe), "1500", "7", "1e4"], timeout=600)
+    assert summary["injected"] >= 1 and summary["no_stop"] > 1000
+
+
+def test_valgrind_memcheck_of_a_1000_step_closed_loop_reports_no_error(soak_dir: Path, tmp_path: Path) -> None:
+    valgrind = require_tool("valgrind")
+    exe = build_closed_loop(soak_dir, tmp_path / "loop_vg", "gcc", ["-O1", "-g"])
+    summary = run_closed_loop([valgrind, "--error-exitcode=99", "--leak-check=full", "--errors-for-leak-kinds=all",
+                               "--quiet", str(exe), "1000", "3", "1e5"], timeout=1200)
+    assert summary["steps"] == 1000
+
+
+def test_soak_of_100000_rti_steps_in_a_changing_crowd(soak_dir: Path, tmp_path: Path) -> None:
+    """No crash, every stop has a reason, no step with a human within d_h without a stop in force."""
+    exe = build_closed_loop(soak_dir, tmp_path / "loop_soak", "gcc", ["-O2"])
+    summary = run_closed_loop([str(exe), "100000", "11", "20"], timeout=1800)
+    print("soak:", json.dumps(summary))
+    assert summary["steps"] == 100000 and summary["injected"] >= 100
+    (tmp_path / "soak.json").write_text(json.dumps(summary))
+
+
+def test_libfuzzer_over_the_step_function_finds_nothing(tmp_path: Path) -> None:
+    clang = require_tool("clang")
+    d = make_solver(tmp_path, {"name": "fuzz", "horizon": {"N": 12, "T": 1.2}, "humans": {"max": 4}})
+    exe = tmp_path / "fuzz_step"
+    cmd = [clang, *STRICT, "-O1", "-g", "-fsanitize=fuzzer,address,undefined", "-fno-sanitize-recover=all",
+           '-DSOLVER_HEADER="fuzz.h"', "-DSOLVER_PREFIX=fuzz_", "-I", str(d), str(C_DIR / "fuzz_step.c"),
+           str(d / "fuzz.c"), str(d / "fuzz_model.c"), "-lm", "-o", str(exe)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    assert proc.returncode == 0, proc.stderr
+    # Seed corpus: a valid step's input, from the Python binding's own struct.
+    solver = humanmpc.load(d)
+    corpus = tmp_path / "corpus"
+    corpus.mkdir()
+    solver._load_inputs([0, 0, 0.1, 0.5], [5, 0, 0, 0.8], np.array([[2.0, 1.0]]),
+                        np.tile([[2.0, 1.0]], (13, 1, 1)), [3.0, -1.0])
+    (corpus / "valid").write_bytes(bytes(solver._ffi.buffer(solver._in)))
+    proc = subprocess.run([str(exe), "-max_total_time=25", "-seed=1", "-rss_limit_mb=2048",
+                           "-print_final_stats=1", str(corpus)],
+                          capture_output=True, text=True, timeout=300, check=False, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-4000:]
+    executed = [line for line in proc.stderr.splitlines() if "stat::number_of_executed_units" in line]
+    assert executed and int(executed[0].split(":")[-1]) > 1000
