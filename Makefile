@@ -1,6 +1,7 @@
 # humanmpc: the README's commands.
 #   make test   install what is missing (apt packages as root, .venv, pip) and run the whole suite
-#   make demo   generate + build the solver of the built-in default spec and show what was built
+#   make demo   generate + build the default solver, run the crossing-group scenario with the MPC and
+#               the DWB baseline, print the metrics side by side and write the figure
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
@@ -52,7 +53,7 @@ test: venv
 demo: venv
 	$(GEN) generate -o generated/paper --force
 	$(GEN) build generated/paper
-	$(GEN) info generated/paper
+	$(GEN) demo --out out/demo
 
 bench: venv
 	$(GEN) bench --out out/bench

@@ -659,7 +659,14 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
         ocp_nlp_set_x0(s, in);
         s->ipm_arg.should_stop = ocp_nlp_deadline_passed;
         s->ipm_arg.stop_ctx = s;
-        qp_status = ocp_nlp_qp_step(s, &out->qp_iterations);
+        if (s->params.line_search) {
+            /* A damped step: with the paper's zero control weights the Gauss-Newton curvature in
+             * omega is tiny, and full steps overshoot from one bound of omega to the other. */
+            s->merit_mu = HM_R(1.0);
+            qp_status = ocp_nlp_qp_line_search_step(s, in, s->params.qp_tol, &out->qp_iterations);
+        } else {
+            qp_status = ocp_nlp_qp_step(s, &out->qp_iterations);
+        }
         s->ipm_arg.should_stop = 0;
         s->ipm_arg.stop_ctx = 0;
         /* With the multipliers of this QP: how far the linearisation point is from a KKT point. */

@@ -78,6 +78,13 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from humanmpc.demo import run_demo
+
+    run_demo(seed=args.seed, out_dir=args.out)
+    return 0
+
+
 def _cmd_keys(args: argparse.Namespace) -> int:
     width = max(len(k) for k, _, _ in describe_schema())
     for key, doc, default in describe_schema():
@@ -131,6 +138,19 @@ def make_parser() -> argparse.ArgumentParser:
 
     add_compare_arguments(p)
     p.set_defaults(func=_cmd_bench)
+
+    from humanmpc.sim_commands import add_evaluate_parser, add_simulate_parser
+
+    add_simulate_parser(sub)
+    add_evaluate_parser(sub)
+
+    p = sub.add_parser("demo", help="the main job: both planners in the crossing-group scenario",
+                       description="Generate the default solver, run the crossing-group scenario with the MPC "
+                       "and the DWB baseline, print their metrics side by side and the timing summary, "
+                       "and write the figure.")
+    p.add_argument("--seed", type=int, default=0, help="scenario seed (default 0)")
+    p.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
+    p.set_defaults(func=_cmd_demo)
 
     p = sub.add_parser("keys", help="list every spec key with its default and meaning",
                        description="List every spec key with its default value and meaning.")

@@ -122,6 +122,7 @@ def template_context(spec: Spec, functions: list[EmittedFunction], real: str) ->
         "dt": c_float(spec.dt),
         "params": runtime_params(spec),
         "qp_max_iter": int(spec.solver.qp_max_iter),
+        "line_search": 1 if spec.solver.line_search else 0,
         "functions": [_function_context(name, ef) for ef in functions],
     }
 

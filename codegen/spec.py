@@ -119,6 +119,11 @@ class Rule:
         return (lo, hi), problems
 
     # -- strings --------------------------------------------------------------------------------
+    def _check_boolean(self, path: str, value: Any) -> tuple[Any, list[str]]:
+        if not isinstance(value, bool):
+            return None, [f"{path}: {value!r} has the wrong type: must be true or false"]
+        return value, []
+
     def _check_choice(self, path: str, value: Any) -> tuple[Any, list[str]]:
         if not isinstance(value, str) or value not in self.choices:
             return None, [f"{path}: {value!r} is not allowed: must be one of {', '.join(self.choices)}"]
@@ -158,6 +163,10 @@ def vector(default: tuple[float, ...], doc: str, *, ge: float | None = None, le:
 
 def interval(default: tuple[float, float], doc: str) -> Any:
     return _field(default, Rule("interval", doc))
+
+
+def boolean(default: bool, doc: str) -> Any:
+    return _field(default, Rule("boolean", doc))
 
 
 def choice(default: str, doc: str, choices: tuple[str, ...]) -> Any:
@@ -226,6 +235,9 @@ class Solver:
     regularization: float = number(1e-6, "Levenberg-Marquardt term added to the QP Hessian", ge=0.0, le=1e3)
     qp_max_iter: int = integer(50, "interior-point iteration limit per QP", ge=1, le=1000)
     qp_tol: float = number(1e-6, "QP convergence tolerance", gt=0.0, le=1.0)
+    line_search: bool = boolean(
+        False, "RTI: damp the QP step by a backtracking line search on the l1 merit (false: full step)"
+    )
 
 
 @dataclass(frozen=True)

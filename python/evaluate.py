@@ -129,6 +129,10 @@ def evaluate(
         raise ValueError("evaluate needs at least one seed")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    # One instance of each planner here, before the workers fork: one-time setup (the MPC generates
+    # and builds its solver when missing) must not run in two workers at once.
+    for name in planners:
+        make_planner(name)
     first = seeds[0]
     jobs = [Job(s, p, int(seed), figures and seed == first) for s in scenarios for p in planners for seed in seeds]
     results: list[tuple[Row, EpisodeLog | None]] = []

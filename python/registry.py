@@ -40,4 +40,12 @@ def make_planner(name: str) -> Planner:
     return factory()
 
 
+def _make_mpc() -> Planner:
+    # Imported here: loading the MPC generates and builds its solver when that is missing.
+    from humanmpc.mpc_planner import MPCPlanner
+
+    return MPCPlanner()
+
+
 register_planner("dwb", DWBPlanner)
+register_planner("mpc", _make_mpc)

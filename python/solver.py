@@ -246,9 +246,14 @@ class Solver:
                 raise KeyError(f"unknown parameter {key!r}; parameters are {', '.join(self._param_fields)}")
             ftype = self._param_fields[key]
             if key == "qp_max_iter":
-                if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 10000:
-                    raise ValueError(f"qp_max_iter must be an integer in [1, 10000], got {value!r}")
+                if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 1000:
+                    raise ValueError(f"qp_max_iter must be an integer in [1, 1000], got {value!r}")
                 staged.append((key, value))
+                continue
+            if key == "line_search":
+                if not isinstance(value, bool) and value not in (0, 1):
+                    raise ValueError(f"line_search must be true or false, got {value!r}")
+                staged.append((key, int(value)))
                 continue
             arr = np.asarray(value, dtype=np.float64)
             size = ftype.length if ftype.kind == "array" else 1
