@@ -29,7 +29,7 @@ from humanmpc.codegen.generate import generate
 from humanmpc.codegen.spec import Spec, resolve_spec
 
 from .bindings import load
-from .solver import QP_STATUS_NAMES, Solver
+from .solver import QP_STATUS_NAMES, STOP_REASONS, Solver
 
 AREA_X = (-1.0, 13.0)
 AREA_Y = (-5.0, 5.0)
@@ -63,7 +63,8 @@ class BenchResult:
     qp_iterations_mean: float
     qp_iterations_max: int
     qp_status: dict[str, int]
-    solved_fraction: float
+    solved_fraction: float  # of the steps where a QP ran
+    stops: dict[str, int]
     min_human_distance: float
 
 
@@ -117,7 +118,7 @@ def run_closed_loop(solver: Solver, k: int, seed: int, steps: int,
     scene = CrowdScene(k, rng, x[:2])
     solver.reset()
     out: dict[str, list[float]] = {key: [] for key in
-                                   ("c_ms", "py_ms", "prep_ms", "qp_iter", "qp_status", "dist")}
+                                   ("c_ms", "py_ms", "prep_ms", "qp_iter", "qp_status", "dist", "reason")}
     for _ in range(steps):
         goal = goals[goal_index].copy()
         dist_goal = float(np.hypot(*(goal[:2] - x[:2])))
@@ -140,6 +141,7 @@ def run_closed_loop(solver: Solver, k: int, seed: int, steps: int,
         out["qp_iter"].append(r.qp_iterations)
         out["qp_status"].append(r.qp_status)
         out["dist"].append(float(np.min(np.linalg.norm(scene.pos - x[:2], axis=1))) if k else np.inf)
+        out["reason"].append(r.stop_reason)
         u = r.u0 if np.all(np.isfinite(r.u0)) else np.array([-1.0, 0.0])
         x = _unicycle(x, u, dims.dt)
         x[3] = min(max(x[3], 0.0), 1.0)
@@ -153,13 +155,15 @@ def bench_solver(solver: Solver, k: int, seeds: int, steps: int) -> BenchResult:
         for key, vals in run_closed_loop(solver, k, seed, steps).items():
             samples.setdefault(key, []).extend(vals)
     statuses = Counter(QP_STATUS_NAMES.get(int(s), str(s)) for s in samples["qp_status"])
+    ran = len(samples["qp_status"]) - statuses.get("not_run", 0)
+    stops = Counter(str(STOP_REASONS[int(r)]) for r in samples["reason"] if int(r))
     c_total = sum(samples["c_ms"])
     return BenchResult(
         humans=k, steps=len(samples["c_ms"]), seeds=seeds,
         c_total_ms=TimingStats.of(samples["c_ms"]), python_ms=TimingStats.of(samples["py_ms"]),
         prepare_share=sum(samples["prep_ms"]) / c_total if c_total > 0 else 0.0,
         qp_iterations_mean=statistics.fmean(samples["qp_iter"]), qp_iterations_max=int(max(samples["qp_iter"])),
-        qp_status=dict(statuses), solved_fraction=statuses.get("solved", 0) / len(samples["qp_status"]),
+        qp_status=dict(statuses), solved_fraction=statuses.get("solved", 0) / max(ran, 1), stops=dict(stops),
         min_human_distance=float(min(samples["dist"])),
     )
 
@@ -189,16 +193,17 @@ def machine_description() -> str:
 def markdown_table(results: Sequence[BenchResult]) -> str:
     rows = [
         "| N_h | steps | C step mean / median / min / max / p99 [ms] | Python step mean / p99 / max [ms] "
-        "| prep. share | QP iter mean / max | QP status | min dist [m] |",
-        "|---|---|---|---|---|---|---|---|",
+        "| prep. share | QP iter mean / max | QP status | stops | min dist [m] |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in results:
         c, p = r.c_total_ms, r.python_ms
         status = ", ".join(f"{k}: {v}" for k, v in sorted(r.qp_status.items()))
+        stops = ", ".join(f"{k}: {v}" for k, v in sorted(r.stops.items())) or "none"
         rows.append(
             f"| {r.humans} | {r.steps} | {c.mean:.3f} / {c.median:.3f} / {c.min:.3f} / {c.max:.3f} / {c.p99:.3f} "
             f"| {p.mean:.3f} / {p.p99:.3f} / {p.max:.3f} | {100 * r.prepare_share:.0f}% "
-            f"| {r.qp_iterations_mean:.1f} / {r.qp_iterations_max} | {status} | {r.min_human_distance:.2f} |"
+            f"| {r.qp_iterations_mean:.1f} / {r.qp_iterations_max} | {status} | {stops} | {r.min_human_distance:.2f} |"
         )
     return "\n".join(rows) + "\n"
 

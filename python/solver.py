@@ -30,7 +30,9 @@ STOP_REASONS = {
     6: "human_too_close",
     7: "unsafe_plan",
 }
-QP_STATUS_NAMES = {0: "solved", 1: "max_iter", 2: "infeasible", 3: "numerical", 4: "nonfinite", 5: "timeout"}
+QP_STATUS_NAMES = {
+    -1: "not_run", 0: "solved", 1: "max_iter", 2: "infeasible", 3: "numerical", 4: "nonfinite", 5: "timeout",
+}
 
 
 @dataclass(frozen=True)
