@@ -13,16 +13,19 @@ STAMP := $(VENV)/.installed
 
 # Debian packages the suite needs: compilers (gcc, clang + its sanitizer/fuzzer runtime), make and
 # CMake for the generated package, binutils for nm, valgrind, Python venv support, and Debian's Ipopt
-# (with the BLAS/LAPACK it links) for the C reference solver.
+# (with the BLAS/LAPACK it links) for the C reference solver; the Cortex-M cross compiler, newlib and
+# QEMU for the firmware build, g++ and Eigen for the C++ face (docs/firmware.md).
 APT_PACKAGES := gcc clang libclang-rt-14-dev make cmake binutils valgrind python3-venv python3-dev \
-	coinor-libipopt-dev libblas-dev liblapack-dev
+	coinor-libipopt-dev libblas-dev liblapack-dev \
+	gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm libeigen3-dev g++
 
-.PHONY: help test demo bench system-deps venv lint clean
+.PHONY: help test demo bench firmware system-deps venv lint clean
 
 help:
 	@echo "make test   - set up everything on a fresh Debian machine and run the whole test suite"
 	@echo "make demo   - generate and build the solver of the built-in default spec"
 	@echo "make bench  - time the RTI in random crowds; compare with acados and Ipopt (docs/benchmarks.md)"
+	@echo "make firmware - the solver on Cortex-M7 (double) and Cortex-M4 (float) under QEMU (docs/firmware.md)"
 	@echo "make lint   - ruff and mypy"
 
 system-deps:
@@ -58,6 +61,15 @@ demo: venv
 bench: venv
 	$(GEN) bench --out out/bench
 	$(GEN) bench --compare --compare-out out/compare
+
+# The default spec's solver as firmware: double on a Cortex-M7, float on a Cortex-M4F, each replaying
+# a recorded crowd under QEMU and compared with the host library.
+firmware: venv
+	$(GEN) generate -o generated/paper --force
+	$(GEN) firmware generated/paper --cpu cortex-m7
+	@mkdir -p out/firmware && printf 'name: paper_float\nprecision: float\n' > out/firmware/paper_float.yaml
+	$(GEN) generate out/firmware/paper_float.yaml -o generated/paper_float --force
+	$(GEN) firmware generated/paper_float --cpu cortex-m4
 
 lint: venv
 	$(PY) -m ruff check codegen python tests

@@ -27,6 +27,25 @@ _DEFINITION = re.compile(
 _GLOBAL_HELPER = re.compile(r"^(?!static )(?!CASADI_SYMBOL_EXPORT )([A-Za-z_][\w \*]*\bcasadi_\w+\()", re.MULTILINE)
 
 
+# The <math.h> functions CasADi's code generator may call. casadi_real = float only changes the
+# type: the calls stay double (sin, exp, ...) and so do the literals (2., 1.0000000000000001e-01), so
+# every operation promotes to double and back. On a single-precision FPU (Cortex-M4) that is
+# soft-float double arithmetic, ~19x slower, and it breaks -Wdouble-promotion. A float build maps
+# each call to its C99 f-variant and gives each floating literal the f suffix, in the text itself:
+# the file stays correct with any compiler and flags (no -fsingle-precision-constant, no
+# force-included header that every build system would have to repeat).
+_MATH_FUNCTIONS = (
+    "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh", "asinh", "acosh", "atanh",
+    "exp", "expm1", "log", "log1p", "log10", "sqrt", "cbrt", "pow", "fabs", "fmod", "fmin", "fmax", "floor",
+    "ceil", "round", "trunc", "erf", "erfc", "copysign", "hypot",
+)
+_MATH_CALL = re.compile(r"(?<![\w.])(" + "|".join(_MATH_FUNCTIONS) + r")(?=\s*\()")
+# A decimal floating literal without suffix: 2., 0.5, .5, 1e-6, 1.0000000000000001e-01.
+_DOUBLE_LITERAL = re.compile(
+    r"(?<![\w.])((?:[0-9]+\.[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?|[0-9]+[eE][-+]?[0-9]+)(?![\w.])"
+)
+
+
 @dataclass(frozen=True)
 class EmittedFunction:
     model: ModelFunction
@@ -57,6 +76,12 @@ def make_parameters_used(source: str) -> str:
 
 def make_helpers_static(source: str) -> str:
     return _GLOBAL_HELPER.sub(r"static \1", source)
+
+
+def make_single_precision(source: str) -> str:
+    """Single-precision math calls and float literals in CasADi's C (comments and strings hold none
+    that matter: a version number such as 3.8.2 is left alone by the look-arounds)."""
+    return _DOUBLE_LITERAL.sub(r"\1f", _MATH_CALL.sub(r"\1f", source))
 
 
 def emit_model(functions: tuple[ModelFunction, ...], prefix: str, real: str, out_dir: Path) -> list[EmittedFunction]:
@@ -92,11 +117,15 @@ def emit_model(functions: tuple[ModelFunction, ...], prefix: str, real: str, out
             )
         )
     cg.generate(str(out_dir) + "/")
+    single = " single-precision math and literals," if real == "float" else ""
     banner = (
         f"/* {basename}.c: model functions of the humanmpc solver \"{prefix}\", written by CasADi "
-        f"{ca.CasadiMeta.version()}\n * and adjusted mechanically by humanmpc (static helpers, parameters marked "
-        "used). Do not edit. */\n"
+        f"{ca.CasadiMeta.version()}\n * and adjusted mechanically by humanmpc (static helpers,{single} parameters "
+        "marked used). Do not edit. */\n"
     )
     c_file = out_dir / f"{basename}.c"
-    c_file.write_text(banner + make_helpers_static(make_parameters_used(c_file.read_text())))
+    text = make_helpers_static(make_parameters_used(c_file.read_text()))
+    if real == "float":
+        text = make_single_precision(text)
+    c_file.write_text(banner + text)
     return emitted

@@ -143,6 +143,9 @@ def make_parser() -> argparse.ArgumentParser:
 
     add_simulate_parser(sub)
     add_evaluate_parser(sub)
+    from .firmware import add_firmware_parser
+
+    add_firmware_parser(sub)
 
     p = sub.add_parser("demo", help="the main job: both planners in the crossing-group scenario",
                        description="Generate the default solver, run the crossing-group scenario with the MPC "

@@ -30,7 +30,8 @@ class GenerateError(RuntimeError):
     """The output folder could not be written (the spec itself was fine)."""
 
 
-def _populate(spec: Spec, out: Path, real: str) -> dict[str, object]:
+def _populate(spec: Spec, out: Path) -> dict[str, object]:
+    real = spec.precision
     model = OcpModel(spec)
     emitted = emit_model(model.functions, spec.name, real, out)
     context = template_context(spec, emitted, real)
@@ -126,7 +127,7 @@ def write_atomically(dest: Path, populate: Callable[[Path], object], force: bool
         raise
 
 
-def generate(spec: Spec, out_dir: str | Path, *, force: bool = False, real: str = "double",
+def generate(spec: Spec, out_dir: str | Path, *, force: bool = False,
              log: Callable[[str], None] | None = None) -> Path:
     """Generate the solver package of ``spec`` into ``out_dir``; return its path."""
     # Specs can be built in code, bypassing the loader: validate again before anything reaches C.
@@ -134,6 +135,7 @@ def generate(spec: Spec, out_dir: str | Path, *, force: bool = False, real: str 
     check_resources()
     say = log or (lambda msg: print(msg, file=sys.stderr))
     dest = Path(out_dir)
-    say(f"[humanmpc] generating solver '{spec.name}' (N={spec.horizon.N}, N_h={spec.humans.max}) into {dest}")
-    write_atomically(dest, lambda tmp: _populate(spec, tmp, real), force)
+    say(f"[humanmpc] generating solver '{spec.name}' (N={spec.horizon.N}, N_h={spec.humans.max}, "
+        f"{spec.precision}) into {dest}")
+    write_atomically(dest, lambda tmp: _populate(spec, tmp), force)
     return dest.resolve()

@@ -29,6 +29,7 @@ TEMPLATES = {
     "cffi_cdef.h.j2": "{name}_cffi.h",
     "Makefile.j2": "Makefile",
     "CMakeLists.txt.j2": "CMakeLists.txt",
+    "solver.hpp.j2": "{name}.hpp",
 }
 
 
@@ -94,8 +95,9 @@ def _function_context(prefix: str, ef: EmittedFunction) -> dict[str, Any]:
         "name": c_identifier(mf.name),
         "doc": mf.doc.replace("*/", "* /"),
         "casadi_name": c_identifier(ef.casadi_name),
-        "inputs": [{"name": c_identifier(p.name), "size": p.size} for p in mf.inputs],
-        "outputs": [{"name": c_identifier(p.name), "size": p.size} for p in mf.outputs],
+        "inputs": [{"name": c_identifier(p.name), "size": p.size, "rows": p.rows, "cols": p.cols} for p in mf.inputs],
+        "outputs": [{"name": c_identifier(p.name), "size": p.size, "rows": p.rows, "cols": p.cols}
+                    for p in mf.outputs],
         "sz_arg": ef.sz_arg,
         "sz_res": ef.sz_res,
         "sz_iw": ef.sz_iw,

@@ -40,21 +40,23 @@ class Dims:
     T: float
 
 
-def _as_input(fn: str, port: str, value: ArrayLike, shape: tuple[int, ...]) -> FloatArray:
+def _as_input(fn: str, port: str, value: ArrayLike, shape: tuple[int, ...], dtype: Any = np.float64) -> Any:
     arr = np.asarray(value, dtype=np.float64)
     if arr.shape != shape and not (arr.size == 1 and shape == ()):
         want = "a scalar" if shape == () else f"shape {shape}"
         raise ValueError(f"{fn}(): input '{port}' must be {want}, got shape {arr.shape}")
     # Column-major buffer for matrices, as the C code reads them.
-    return np.ascontiguousarray(arr.reshape(shape).T if arr.ndim == 2 else arr.reshape(-1))
+    return np.ascontiguousarray(arr.reshape(shape).T if arr.ndim == 2 else arr.reshape(-1), dtype=dtype)
 
 
 class ModelFunction:
     """One generated model function, callable on numpy arrays; returns a named tuple of outputs."""
 
-    def __init__(self, ffi: cffi.FFI, cfunc: Callable[..., int], meta: dict[str, Any]) -> None:
+    def __init__(self, ffi: cffi.FFI, cfunc: Callable[..., int], meta: dict[str, Any], real: str = "double") -> None:
         self._ffi = ffi
         self._cfunc = cfunc
+        self._ctype = f"{real}[]"  # buffers of the solver's real type; results are returned as float64
+        self._dtype = np.dtype(np.float32 if real == "float" else np.float64)
         self.name: str = meta["name"]
         self.__doc__ = meta["doc"]
         self.inputs: list[tuple[str, tuple[int, ...]]] = [
@@ -67,14 +69,15 @@ class ModelFunction:
         if len(args) != len(self.inputs):
             names = ", ".join(n for n, _ in self.inputs)
             raise TypeError(f"{self.name}() takes {len(self.inputs)} inputs ({names}), got {len(args)}")
-        ins = [_as_input(self.name, n, a, shape) for (n, shape), a in zip(self.inputs, args, strict=True)]
-        outs = [np.empty(r * c) for _, (r, c) in self.outputs]
+        ins = [_as_input(self.name, n, a, shape, self._dtype) for (n, shape), a in zip(self.inputs, args, strict=True)]
+        outs = [np.empty(r * c, dtype=self._dtype) for _, (r, c) in self.outputs]
         fb = self._ffi.from_buffer
-        ret = self._cfunc(*[fb("double[]", a) for a in ins], *[fb("double[]", o) for o in outs])
+        ret = self._cfunc(*[fb(self._ctype, a) for a in ins], *[fb(self._ctype, o) for o in outs])
         if ret != 0:
             raise RuntimeError(f"{self.name}() returned {ret}")
         shaped: list[float | FloatArray] = []
-        for (_, (r, c)), o in zip(self.outputs, outs, strict=True):
+        for (_, (r, c)), out in zip(self.outputs, outs, strict=True):
+            o = out.astype(np.float64, copy=False)
             if r == 1 and c == 1:
                 shaped.append(float(o[0]))
             elif c == 1:
@@ -126,6 +129,7 @@ def load(solver_dir: str | Path, *, build_if_needed: bool = True) -> Solver:
     m = manifest["dims"]
     dims_obj = Dims(nx=m["nx"], nu=m["nu"], N=m["N"], nh=m["nh"], ng=m["ng"], dt=m["dt"], T=m["T"])
     model = ModelFunctions(
-        {f["name"]: ModelFunction(ffi, getattr(lib, f"{name}_{f['name']}"), f) for f in manifest["functions"]}
+        {f["name"]: ModelFunction(ffi, getattr(lib, f"{name}_{f['name']}"), f, manifest.get("real", "double"))
+         for f in manifest["functions"]}
     )
     return Solver(name, dims_obj, ffi, lib, model, d, manifest["spec_hash"])

@@ -78,8 +78,9 @@ class StepResult:
         return max(self.kkt_stat, self.kkt_eq, self.kkt_ineq, self.kkt_comp)
 
 
-def _view(ffi: Any, cdata: Any, shape: tuple[int, ...]) -> FloatArray:
-    return np.frombuffer(ffi.buffer(cdata), dtype=np.float64).reshape(shape)
+def _view(ffi: Any, cdata: Any, shape: tuple[int, ...], dtype: Any = np.float64) -> Any:
+    """A numpy array over a C array of the solver's real type (float32 for a float solver)."""
+    return np.frombuffer(ffi.buffer(cdata), dtype=dtype).reshape(shape)
 
 
 class Solver:
@@ -108,15 +109,19 @@ class Solver:
         self._in = ffi.new(f"{name}_input *")
         self._out = ffi.new(f"{name}_output *")
         N, nh_alloc = dims.N, max(1, dims.nh)
-        self._x0 = _view(ffi, self._in.x0, (4,))
-        self._goal = _view(ffi, self._in.goal, (4,))
-        self._h_now = _view(ffi, self._in.humans_now, (nh_alloc, 2))
-        self._h_pred = _view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2))
-        self._obstacle = _view(ffi, self._in.obstacle, (2,))
-        self._out_x = _view(ffi, self._out.x, (N + 1, 4))
-        self._out_u = _view(ffi, self._out.u, (N, 2))
-        self._out_u0 = _view(ffi, self._out.u0, (2,))
-        self._out_cmd = _view(ffi, self._out.command, (2,))
+        # The C arrays hold the solver's real type; inputs are rounded to it on assignment, results
+        # are handed out as float64 copies either way.
+        self.dtype = np.dtype(np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64)
+        rt = self.dtype
+        self._x0 = _view(ffi, self._in.x0, (4,), rt)
+        self._goal = _view(ffi, self._in.goal, (4,), rt)
+        self._h_now = _view(ffi, self._in.humans_now, (nh_alloc, 2), rt)
+        self._h_pred = _view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2), rt)
+        self._obstacle = _view(ffi, self._in.obstacle, (2,), rt)
+        self._out_x = _view(ffi, self._out.x, (N + 1, 4), rt)
+        self._out_u = _view(ffi, self._out.u, (N, 2), rt)
+        self._out_u0 = _view(ffi, self._out.u0, (2,), rt)
+        self._out_cmd = _view(ffi, self._out.command, (2,), rt)
         self._param_fields = {f: t.type for f, t in ffi.typeof(f"{name}_params").fields}
         self.log: StepLog | None = None
 
@@ -172,7 +177,8 @@ class Solver:
         o = self._out
         r = StepResult(
             stop=bool(o.stop), stop_reason=o.stop_reason,
-            u0=self._out_u0.copy(), command=self._out_cmd.copy(), x=self._out_x.copy(), u=self._out_u.copy(),
+            u0=self._out_u0.astype(np.float64), command=self._out_cmd.astype(np.float64),
+            x=self._out_x.astype(np.float64), u=self._out_u.astype(np.float64),
             status=o.status, qp_status=o.qp_status, qp_iterations=o.qp_iterations,
             sqp_iterations=o.sqp_iterations, cost=o.cost, kkt_stat=o.kkt_stat, kkt_eq=o.kkt_eq,
             kkt_ineq=o.kkt_ineq, kkt_comp=o.kkt_comp, min_human_distance=o.min_human_distance,
