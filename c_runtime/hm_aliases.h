@@ -9,7 +9,10 @@ typedef HM_NS(ocp_qp) hm_ocp_qp;
 typedef HM_NS(ocp_qp_sol) hm_ocp_qp_sol;
 typedef HM_NS(ocp_qp_res) hm_ocp_qp_res;
 typedef HM_NS(ocp_qp_ipm_arg) hm_ocp_qp_ipm_arg;
+typedef HM_NS(ocp_qp_ipm_stage) hm_ocp_qp_ipm_stage;
 typedef HM_NS(ocp_qp_ipm_vec) hm_ocp_qp_ipm_vec;
 typedef HM_NS(ocp_qp_ipm_ws) hm_ocp_qp_ipm_ws;
+typedef HM_NS(ocp_qp_hsde_vec) hm_ocp_qp_hsde_vec;
+typedef HM_NS(ocp_qp_hsde_ws) hm_ocp_qp_hsde_ws;
 
 #endif /* HM_ALIASES_H */

@@ -73,10 +73,17 @@ typedef struct HM_NS(ocp_qp_sol) {
 /* ------------------------------------------------------------------------------------------------
  * ocp_qp_ipm: the interior-point solver of ocp_qp (ocp_qp_ipm.h, ocp_qp_kkt.h, ocp_qp.h).
  *
- * The solver works on a homogeneous self-dual embedding of the QP. Its inequality rows (present
- * bounds, general rows, s >= 0 of soft rows) are packed stage after stage into flat arrays of at
- * most (HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG) entries, so that absent rows take neither
- * time nor a place in the iteration; the map from rows to the QP is rebuilt by every solve.
+ * A primal-dual (infeasible-start, Mehrotra predictor-corrector) method. Its inequalities are kept
+ * per stage in fixed-size blocks of three families, so that every loop has a compile-time bound or
+ * visits only what is present:
+ *   bound pairs   a component of (u, x) with a lower and/or an upper bound: the two sides are the
+ *                 two lanes of a 2-vector (an absent side is a lane with sign 0 and a neutral state);
+ *   soft rows     D' p + s >= lg with its slack s >= 0 (s is its own slack: no second slack);
+ *   hard rows     D' p >= lg.
+ * Rows are processed two at a time (2-wide SIMD where the compiler can); a stage with an odd count
+ * pads its family with one neutral row (D = 0, state reset to 1, masked out of every sum).
+ * The arrays below are sized HM_QP_NGP = HM_NG rounded up to even, written out since this file has
+ * no include guard.
  * ---------------------------------------------------------------------------------------------- */
 
 /* Residuals of a primal-dual pair (ocp_qp_res_compute), infinity norms in the units of the data. */
@@ -101,20 +108,94 @@ typedef struct HM_NS(ocp_qp_ipm_arg) {
     void *stop_ctx;
 } HM_NS(ocp_qp_ipm_arg);
 
+/* One stage of the solver: its inequality families, its part of the iterate and of the direction,
+ * and its part of the Newton system. Stage n carries (u_n, x_n) as one 6-vector ux (u first; u of
+ * stage HM_N and x of stage 0 unused), and y_n, the multiplier of the dynamics from n to n + 1. */
+typedef struct HM_NS(ocp_qp_ipm_stage) {
+    /* structure, set up by every solve */
+    int nbp;                          /* bound pairs */
+    int ns, nh;                       /* soft rows, hard rows */
+    int ns2, nh2;                     /* the same rounded up to even (rows go in pairs) */
+    int a_id;                         /* 1: the first two columns of A_n are e_0, e_1 */
+    unsigned char bc[HM_NU + HM_NX];  /* component of ux of bound pair k */
+    unsigned char srow[(HM_NG + 1) / 2 * 2];   /* QP row of soft row j */
+    unsigned char hrow[(HM_NG + 1) / 2 * 2];   /* QP row of hard row j */
+    /* cost times the cost scale (stage 0: x_0 terms folded into q), dynamics offset (stage 0:
+     * b_0 + A_0 x_0); column-major like ocp_qp */
+    HM_REAL R[HM_NU * HM_NU], S[HM_NU * HM_NX], Q[HM_NX * HM_NX], q[HM_NU + HM_NX], beq[HM_NX];
+
+    /* bound pairs, lane 0 the lower and lane 1 the upper bound: sign * ux[c] + t = b, i.e.
+     * sign -1 and b = -lb, sign +1 and b = ub; an absent side has sign 0 and b = 1 */
+    HM_REAL bsg[HM_NU + HM_NX][2], bb[HM_NU + HM_NX][2];
+    HM_REAL bt[HM_NU + HM_NX][2], bz[HM_NU + HM_NX][2];          /* slack, multiplier */
+    HM_REAL bdt[HM_NU + HM_NX][2], bdz[HM_NU + HM_NX][2];        /* step */
+    HM_REAL bw[HM_NU + HM_NX][2], bti[HM_NU + HM_NX][2], bzi[HM_NU + HM_NX][2];   /* z/t, 1/t, 1/z */
+    HM_REAL brho[HM_NU + HM_NX][2], bdel[HM_NU + HM_NX][2];      /* predictor rhs, dt_aff dz_aff */
+
+    /* soft rows: -(d' p + s) + t = -lg, s >= 0; cost zl s + Zl s^2 / 2 (times the cost scale);
+     * live 1, or 0 for the padding row */
+    HM_REAL sd0[(HM_NG + 1) / 2 * 2], sd1[(HM_NG + 1) / 2 * 2], slg[(HM_NG + 1) / 2 * 2];
+    HM_REAL szl[(HM_NG + 1) / 2 * 2], sZl[(HM_NG + 1) / 2 * 2], slive[(HM_NG + 1) / 2 * 2];
+    HM_REAL ss[(HM_NG + 1) / 2 * 2], st[(HM_NG + 1) / 2 * 2];    /* slack s, row slack t */
+    HM_REAL sz[(HM_NG + 1) / 2 * 2], szs[(HM_NG + 1) / 2 * 2];   /* multipliers of the row, of s >= 0 */
+    HM_REAL sds[(HM_NG + 1) / 2 * 2], sdt[(HM_NG + 1) / 2 * 2];
+    HM_REAL sdz[(HM_NG + 1) / 2 * 2], sdzs[(HM_NG + 1) / 2 * 2];
+    HM_REAL swr[(HM_NG + 1) / 2 * 2], sws[(HM_NG + 1) / 2 * 2];  /* weights z/t, zs/s */
+    HM_REAL shi[(HM_NG + 1) / 2 * 2];                            /* 1 / (Zl + wr + ws) */
+    HM_REAL sti[(HM_NG + 1) / 2 * 2], szi[(HM_NG + 1) / 2 * 2];  /* 1/t, 1/z */
+    HM_REAL ssi[(HM_NG + 1) / 2 * 2], szsi[(HM_NG + 1) / 2 * 2]; /* 1/s, 1/zs */
+    HM_REAL srs[(HM_NG + 1) / 2 * 2];                            /* stationarity residual of s */
+    HM_REAL sdr[(HM_NG + 1) / 2 * 2], sdsb[(HM_NG + 1) / 2 * 2]; /* dt dz, ds dzs of the predictor */
+    HM_REAL se[(HM_NG + 1) / 2 * 2];   /* general solve: slack step at a zero position step */
+
+    /* hard rows: -d' p + t = -lg */
+    HM_REAL hd0[(HM_NG + 1) / 2 * 2], hd1[(HM_NG + 1) / 2 * 2], hlg[(HM_NG + 1) / 2 * 2];
+    HM_REAL hlive[(HM_NG + 1) / 2 * 2];
+    HM_REAL ht[(HM_NG + 1) / 2 * 2], hz[(HM_NG + 1) / 2 * 2];
+    HM_REAL hdt[(HM_NG + 1) / 2 * 2], hdz[(HM_NG + 1) / 2 * 2];
+    HM_REAL hw[(HM_NG + 1) / 2 * 2], hti[(HM_NG + 1) / 2 * 2], hzi[(HM_NG + 1) / 2 * 2];
+    HM_REAL hdel[(HM_NG + 1) / 2 * 2];
+
+    /* iterate and step of the stage; ry: right-hand side of the dynamics n -> n + 1 in the Newton
+     * system (minus their residual) */
+    HM_REAL ux[HM_NU + HM_NX], y[HM_NX], dux[HM_NU + HM_NX], dy[HM_NX], ry[HM_NX];
+    /* Newton system: the families condensed into the stage (diagonal, (px, py) block), gradients of
+     * the predictor and the two parts of the corrector's change, and the Riccati factor */
+    HM_REAL Hd[HM_NU + HM_NX], Hpp[3];
+    HM_REAL ha[HM_NU + HM_NX], hdl[HM_NU + HM_NX], hmu[HM_NU + HM_NX];
+    HM_REAL P[HM_NX * HM_NX], p[HM_NX], Pry[HM_NX];
+    HM_REAL Ld[3];                    /* LDL' of the input block: 1 / d0, l10, 1 / d1 */
+    HM_REAL Kx[HM_NU * HM_NX];        /* L^-1 (input-state block), row j at Kx[j * HM_NX] */
+    HM_REAL yk[HM_NU];
+} HM_NS(ocp_qp_ipm_stage);
+
+/* A vector in the solver's layout (the Newton system's unknowns or right-hand side), used by the
+ * general solve of ocp_qp_kkt.h (tests, polish): per stage ux, the soft slacks by soft row, y, and
+ * one entry per inequality: bound lanes, soft rows, their s >= 0, hard rows. */
+typedef struct HM_NS(ocp_qp_ipm_vec) {
+    HM_REAL ux[HM_N + 1][HM_NU + HM_NX];
+    HM_REAL s[HM_N + 1][(HM_NG + 1) / 2 * 2];
+    HM_REAL y[HM_N][HM_NX];
+    HM_REAL zb[HM_N + 1][HM_NU + HM_NX][2];
+    HM_REAL zr[HM_N + 1][(HM_NG + 1) / 2 * 2];
+    HM_REAL zs[HM_N + 1][(HM_NG + 1) / 2 * 2];
+    HM_REAL zh[HM_N + 1][(HM_NG + 1) / 2 * 2];
+} HM_NS(ocp_qp_ipm_vec);
+
 /* The variables of the embedding that live in the QP's shape: per stage (u, x) (u of stage HM_N and
  * x of stage 0 unused), slacks s[n][k] of the k-th general row if it is soft, multipliers y of the
  * dynamics and z of the packed inequality rows. Used for the iterate, the step, the residuals and a
  * constant solve. */
-typedef struct HM_NS(ocp_qp_ipm_vec) {
+typedef struct HM_NS(ocp_qp_hsde_vec) {
     HM_REAL ux[HM_N + 1][HM_NU + HM_NX];
     HM_REAL s[HM_N + 1][HM_NG];
     HM_REAL y[HM_N][HM_NX];
     HM_REAL z[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
-} HM_NS(ocp_qp_ipm_vec);
+} HM_NS(ocp_qp_hsde_vec);
 
-/* All memory of a solve. Only the first block is meant for the caller. */
-typedef struct HM_NS(ocp_qp_ipm_ws) {
-    /* outcome of the last solve */
+/* The fallback solver (ocp_qp_hsde.h): inequality rows (present bounds, general rows, s >= 0 of
+ * soft rows) packed stage after stage into flat arrays. */
+typedef struct HM_NS(ocp_qp_hsde_ws) {
     int status;
     int iter;                         /* interior-point iterations done */
     HM_NS(ocp_qp_res) res;            /* residuals of the returned solution (ocp_qp_res_compute) */
@@ -143,11 +224,11 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
     HM_REAL b_eq[HM_N][HM_NX];
     HM_REAL b_ineq[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
     HM_REAL norm_q, norm_b;
-    HM_REAL cost_scale;               /* the cost is solved scaled by this (ocp_qp_ipm.c) */
-    HM_REAL w_max;                    /* cap of the row weights (ocp_qp_ipm.c) */
+    HM_REAL cost_scale;               /* the cost is solved scaled by this */
+    HM_REAL w_max;                    /* cap of the row weights */
 
     /* iterate (v, t, tau, kappa), step, constant solve, residuals */
-    HM_NS(ocp_qp_ipm_vec) v, dv, v1, rv;
+    HM_NS(ocp_qp_hsde_vec) v, dv, v1, rv;
     HM_REAL t[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
     HM_REAL dt[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
     HM_REAL dtau, dkappa, rtau;
@@ -157,7 +238,7 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
     HM_REAL zinv[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];   /* 1 / z */
     HM_REAL winv[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];   /* 1 / w */
 
-    /* Newton system (ocp_qp_kkt): row weights z / t, stage-wise eliminated soft slacks, Riccati */
+    /* Newton system: row weights z / t, stage-wise eliminated soft slacks, Riccati */
     HM_REAL w[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
     HM_REAL soft_hinv[HM_N + 1][HM_NG];     /* of the j-th soft row: 1 / (Zl + w_row + w_slack) */
     HM_REAL soft_e[HM_N + 1][HM_NG];        /* per solve: its slack step at a zero position step */
@@ -167,4 +248,31 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
                                                1 / l00, l10, 1 / l11 */
     HM_REAL Y[HM_N][HM_NU * HM_NX];         /* Lr^-1 (S + B' P A) */
     HM_REAL yk[HM_N][HM_NU];                /* per solve: Lr^-1 (reduced input gradient) */
+} HM_NS(ocp_qp_hsde_ws);
+
+/* All memory of a solve. Only the first block is meant for the caller. */
+typedef struct HM_NS(ocp_qp_ipm_ws) {
+    /* outcome of the last solve */
+    int status;
+    int iter;                         /* interior-point iterations done */
+    HM_NS(ocp_qp_res) res;            /* residuals of the returned solution (ocp_qp_res_compute) */
+    HM_REAL res_primal, res_dual, gap;   /* the scaled measures compared with arg->tol */
+    HM_REAL mu;                       /* of the last iterate */
+    int unbounded;                    /* NUMERICAL because a direction of unbounded descent was found */
+    int polished;                     /* the solution is the active-set refinement of the iterate */
+
+    /* the problem as the solver sees it, and its iterate */
+    int m;                            /* inequalities (present bound sides, rows, s >= 0) */
+    HM_REAL cost_scale;               /* the cost is solved scaled by this (ocp_qp_ipm.c) */
+    HM_REAL w_max;                    /* cap of the weights z / t (ocp_qp_ipm.c) */
+    HM_REAL norm_q, norm_b;
+    int fallback;                     /* the solution came from the fallback solver (ocp_qp_hsde.h) */
+    /* the stages, and two vectors for the polish and the general solve; or the fallback's memory */
+    union {
+        struct {
+            HM_NS(ocp_qp_ipm_stage) st[HM_N + 1];
+            HM_NS(ocp_qp_ipm_vec) va, vb;
+        } f;
+        HM_NS(ocp_qp_hsde_ws) hsde;
+    } u;
 } HM_NS(ocp_qp_ipm_ws);

@@ -1,31 +1,48 @@
 /*
- * ocp_qp_ipm.c: interior-point solver of ocp_qp on the homogeneous self-dual embedding
- * (see ocp_qp_ipm.h for the algorithm and the termination rules).
+ * ocp_qp_ipm.c: primal-dual interior-point solver of ocp_qp (see ocp_qp_ipm.h for the algorithm and
+ * the termination rules).
  *
- * Notation as in ocp_qp_ipm.h: v = (u, x, s) is ws->v.ux / ws->v.s, w = (y, z) its multipliers
- * ws->v.y / ws->v.z, t the slacks of the packed inequality rows. A packed row j of stage n is a
- * bound (sign * v_c + t = b: lower bounds have sign -1 and b = -lb), a general row
- * (-(D' p + s) + t = -lg, s only if soft) or the bound of a soft slack (-s + t = 0).
+ * Notation as in ocp_qp_ipm.h and hm_types.h (ocp_qp_ipm_stage). Every inequality is written
+ * a' v + t = b with slack t >= 0 and multiplier z >= 0: a bound side sign * ux[c] + t = b, a soft row
+ * -(d' p + s) + t = -lg, a soft slack's bound -s + s = 0 (its slack is s itself), a hard row
+ * -d' p + t = -lg.
+ *
+ * One iteration is five passes over the stages, each fused so that a stage's data is touched once:
+ *   A (forward)   take the last step, evaluate the residuals, the weights z / t, and condense the
+ *                 inequalities into their stage: Hessian terms (Hd, Hpp), the predictor's gradient
+ *                 (ha) and the gradient per unit of sigma mu (hmu); termination measures.
+ *   B (backward)  factorise, and the predictor's backward substitution.
+ *   C (forward)   the predictor's forward substitution; its inequality steps give the step length,
+ *                 mu_aff and the corrector's second-order gradient terms (hdl), condensed at once.
+ *   D (backward)  the corrector's backward substitution with ha + hdl + sigma mu hmu.
+ *   E (forward)   the corrector's forward substitution and inequality steps, and the step length.
+ * The predictor rhs is (-r_v, -r_y, -rho) with rho = r - c / z per inequality (c the complementarity
+ * target: t z for the predictor, t z + dt dz - sigma mu for the corrector); the corrector's differs
+ * from it only in rho, linearly, which is what lets pass D run on stage vectors alone.
  */
 #include "ocp_qp.h"
 #include "ocp_qp_kkt.h"
 #include "ocp_qp_ipm.h"
+#include "ocp_qp_hsde.c"
 
-/* Cap of the row weights z / t, relative to the curvature of the cost. Near the solution the weights
+/* Cap of the weights z / t, relative to the curvature of the cost. Near the solution the weights
  * of active rows grow like 1 / mu; condensed into the Riccati recursion, whose Schur complements
  * subtract them again, they leave rounding errors of eps * weight in the moderate directions, and
  * beyond ~1e-6 / eps the cost-to-go matrices lose definiteness and the steps go wrong. Capping the
  * weight makes the Newton step slightly inexact on active rows only; that error shrinks with the
- * step itself, so convergence is kept (measured on random QPs solved to 1e-10: 300/300 with the cap,
- * 70% without it). */
+ * step itself, so convergence is kept. In single precision 1e6 (not 1e-6 / eps = 1e1): a tighter
+ * cap makes the steps on active rows so inexact that RTI replays took 25-50 iterations (MAX_ITER
+ * in one step out of 20) against 12-23 at 1e6, which matches the double build's counts. */
 #ifdef HM_REAL_IS_FLOAT
-#define OCP_QP_IPM_W_MAX_REL HM_R(1e4)
+#define OCP_QP_IPM_W_MAX_REL HM_R(1e6)
 #else
 #define OCP_QP_IPM_W_MAX_REL HM_R(1e10)
 #endif
 
-/* max without libm's fmax call (whose NaN rule is not needed here: NaN is caught on the sums) */
+/* max/min without libm's calls (whose NaN rule is not needed here: NaN is caught on the sums) */
 #define OCP_QP_IPM_MAX(a, b) ((a) > (b) ? (a) : (b))
+#define OCP_QP_IPM_MIN(a, b) ((a) < (b) ? (a) : (b))
+#define OCP_QP_IPM_ABS(a) ((a) < HM_R(0.0) ? -(a) : (a))
 
 HM_FUNC void ocp_qp_ipm_arg_set_default(hm_ocp_qp_ipm_arg *arg)
 {
@@ -65,17 +82,24 @@ HM_FUNC const char *ocp_qp_status_message(int status)
     }
 }
 
-/* Packs the present inequality rows and computes the data of the embedding and its norms. Returns
- * HM_QP_INFEASIBLE if a lower bound exceeds its upper bound; *bad = stage * HM_QP_NUX + component. */
+/* ------------------------------------------------------------------------------------------------
+ * Setup: the families, the scaled cost, the norms, the starting point
+ * ---------------------------------------------------------------------------------------------- */
+
+/* Builds the stage blocks of qp and the starting point. Returns HM_QP_INFEASIBLE if a lower bound
+ * exceeds its upper bound; *bad = stage * HM_QP_NUX + component. */
 HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad)
 {
-    int n, i, k, m = 0;
-    hm_real norm_q = HM_R(0.0), norm_b = HM_R(0.0), hscale = HM_R(0.0);
+    int n, i, j, k, m = 0;
+    hm_real norm_q = HM_R(0.0), norm_b = HM_R(0.0), hscale = HM_R(0.0), c;
+
     for (n = 0; n <= HM_N; n++) {
-        int nb = 0, nr = 0, ns = 0;
-        ws->off[n] = m;
+        hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        int nbp = 0, ns = 0, nh = 0;
+        /* bound pairs */
         for (i = 0; i < HM_QP_NUX; i++) {
             hm_real lb, ub;
+            int lp, up;
             if (i < HM_NU) {
                 if (n == HM_N) continue;
                 lb = qp->lbu[n][i];
@@ -85,52 +109,61 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
                 lb = qp->lbx[n][i - HM_NU];
                 ub = qp->ubx[n][i - HM_NU];
             }
-            if (ocp_qp_bound_present(lb)) {
-                if (ocp_qp_bound_present(ub) && lb > ub) {
-                    *bad = n * HM_QP_NUX + i;
-                    return HM_QP_INFEASIBLE;
-                }
-                ws->box_comp[n][nb] = (unsigned char)i;
-                ws->box_sign[n][nb] = HM_R(-1.0);
-                ws->b_ineq[m + nb] = -lb;
-                nb++;
+            lp = ocp_qp_bound_present(lb);
+            up = ocp_qp_bound_present(ub);
+            if (!lp && !up) continue;
+            if (lp && up && lb > ub) {
+                *bad = n * HM_QP_NUX + i;
+                return HM_QP_INFEASIBLE;
             }
-            if (ocp_qp_bound_present(ub)) {
-                ws->box_comp[n][nb] = (unsigned char)i;
-                ws->box_sign[n][nb] = HM_R(1.0);
-                ws->b_ineq[m + nb] = ub;
-                nb++;
-            }
+            sn->bc[nbp] = (unsigned char)i;
+            sn->bsg[nbp][0] = lp ? HM_R(-1.0) : HM_R(0.0);
+            sn->bsg[nbp][1] = up ? HM_R(1.0) : HM_R(0.0);
+            sn->bb[nbp][0] = lp ? -lb : HM_R(1.0);
+            sn->bb[nbp][1] = up ? ub : HM_R(1.0);
+            if (lp) norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(lb));
+            if (up) norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(ub));
+            m += lp + up;
+            nbp++;
         }
+        /* general rows: soft ones and hard ones, each in QP order */
         if (n > 0) {
             for (i = 0; i < qp->ng[n]; i++) {
-                if (!ocp_qp_bound_present(qp->lg[n][i])) continue;
-                ws->row_idx[n][nr] = (unsigned char)i;
-                ws->D[n][nr][0] = qp->D[n][i][0];
-                ws->D[n][nr][1] = qp->D[n][i][1];
-                ws->b_ineq[m + nb + nr] = -qp->lg[n][i];
-                nr++;
-            }
-            for (k = 0; k < nr; k++) {
-                const int i_row = ws->row_idx[n][k];
-                if (!qp->soft[n][i_row]) continue;
-                ws->soft_of[n][ns] = (unsigned char)k;
-                ws->b_ineq[m + nb + nr + ns] = HM_R(0.0);
-                ws->q_s[n][k] = qp->zl[n][i_row];
-                norm_q = OCP_QP_IPM_MAX(norm_q, hm_fabs(qp->zl[n][i_row]));
-                hscale = OCP_QP_IPM_MAX(hscale, hm_fabs(qp->Zl[n][i_row]));
-                ns++;
+                const hm_real lg = qp->lg[n][i];
+                if (!ocp_qp_bound_present(lg)) continue;
+                norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(lg));
+                if (qp->soft[n][i]) {
+                    sn->srow[ns] = (unsigned char)i;
+                    sn->sd0[ns] = qp->D[n][i][0];
+                    sn->sd1[ns] = qp->D[n][i][1];
+                    sn->slg[ns] = lg;
+                    sn->szl[ns] = qp->zl[n][i];
+                    sn->sZl[ns] = qp->Zl[n][i];
+                    sn->slive[ns] = HM_R(1.0);
+                    norm_q = OCP_QP_IPM_MAX(norm_q, hm_fabs(qp->zl[n][i]));
+                    hscale = OCP_QP_IPM_MAX(hscale, hm_fabs(qp->Zl[n][i]));
+                    ns++;
+                } else {
+                    sn->hrow[nh] = (unsigned char)i;
+                    sn->hd0[nh] = qp->D[n][i][0];
+                    sn->hd1[nh] = qp->D[n][i][1];
+                    sn->hlg[nh] = lg;
+                    sn->hlive[nh] = HM_R(1.0);
+                    nh++;
+                }
             }
         }
-        ws->nb[n] = nb;
-        ws->nr[n] = nr;
-        ws->ns[n] = ns;
-        /* the tau row is evaluated by every solve, also those before the first residuals */
-        for (i = 0; i < HM_QP_NUX; i++) ws->c_ux[n][i] = HM_R(0.0);
-        for (k = 0; k < nr; k++) ws->c_s[n][k] = HM_R(0.0);
-        m += nb + nr + ns;
+        sn->nbp = nbp;
+        sn->ns = ns;
+        sn->nh = nh;
+        sn->ns2 = ns + (ns & 1);
+        sn->nh2 = nh + (nh & 1);
+        m += 2 * ns + nh;
 
-        /* linear cost on (u, x); x_0 is data, its terms move into stage 0 */
+        /* cost and dynamics offset, unscaled for now; x_0 is data, its terms move into stage 0 */
+        for (i = 0; i < HM_NU * HM_NU; i++) sn->R[i] = n < HM_N ? qp->R[n][i] : HM_R(0.0);
+        for (i = 0; i < HM_NU * HM_NX; i++) sn->S[i] = (n > 0 && n < HM_N) ? qp->S[n][i] : HM_R(0.0);
+        for (i = 0; i < HM_NX * HM_NX; i++) sn->Q[i] = n > 0 ? qp->Q[n][i] : HM_R(0.0);
         for (i = 0; i < HM_NU; i++) {
             hm_real acc = HM_R(0.0);
             if (n < HM_N) {
@@ -140,85 +173,111 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
                 }
                 hscale = OCP_QP_IPM_MAX(hscale, hm_fabs(qp->R[n][i * (HM_NU + 1)]));
             }
-            ws->q_ux[n][i] = acc;
+            sn->q[i] = acc;
         }
         for (i = 0; i < HM_NX; i++) {
-            ws->q_ux[n][HM_NU + i] = n == 0 ? HM_R(0.0) : qp->q[n][i];
+            sn->q[HM_NU + i] = n == 0 ? HM_R(0.0) : qp->q[n][i];
             if (n > 0) hscale = OCP_QP_IPM_MAX(hscale, hm_fabs(qp->Q[n][i * (HM_NX + 1)]));
         }
-        for (i = 0; i < HM_QP_NUX; i++) norm_q = OCP_QP_IPM_MAX(norm_q, hm_fabs(ws->q_ux[n][i]));
-        if (n < HM_N) {
-            for (i = 0; i < HM_NX; i++) {
-                hm_real acc = qp->b[n][i];
+        for (i = 0; i < HM_QP_NUX; i++) norm_q = OCP_QP_IPM_MAX(norm_q, hm_fabs(sn->q[i]));
+        for (i = 0; i < HM_NX; i++) {
+            hm_real acc = HM_R(0.0);
+            if (n < HM_N) {
+                acc = qp->b[n][i];
                 if (n == 0) {
                     for (k = 0; k < HM_NX; k++) acc += qp->A[0][i + k * HM_NX] * qp->x0[k];
                 }
-                ws->b_eq[n][i] = acc;
-                norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(acc));
             }
+            sn->beq[i] = acc;
+            norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(acc));
+        }
+        sn->a_id = 0;
+        if (n < HM_N) {
+            const hm_real *A = qp->A[n];
+            sn->a_id = A[0] == HM_R(1.0) && A[1] == HM_R(0.0) && A[2] == HM_R(0.0) && A[3] == HM_R(0.0)
+                       && A[4] == HM_R(0.0) && A[5] == HM_R(1.0) && A[6] == HM_R(0.0) && A[7] == HM_R(0.0);
         }
     }
     ws->m = m;
-    for (i = 0; i < m; i++) norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(ws->b_ineq[i]));
 
-    /* Cost scaling (as in Clarabel): the embedding balances cost against constraints through tau and
-     * kappa, and a cost measured in hundreds (goal weight 250) against rows measured in metres made
-     * it take twice the iterations. Clipped so that tiny or huge data are not blown up. */
+    /* Cost scaling (as in Clarabel): a cost measured in hundreds (goal weight 250) or a slack
+     * penalty of 1e4 against rows measured in metres. Clipped so that tiny or huge data are not
+     * blown up. */
     {
         const hm_real mag = OCP_QP_IPM_MAX(hscale, norm_q);
-        const hm_real c = HM_R(1.0) / (mag < HM_R(1e-4) ? HM_R(1e-4) : (mag > HM_R(1e4) ? HM_R(1e4) : mag));
-        for (n = 0; n <= HM_N; n++) {
-            for (i = 0; i < HM_QP_NUX; i++) ws->q_ux[n][i] *= c;
-            for (k = 0; k < ws->nr[n]; k++) ws->q_s[n][k] *= c;
-            for (k = 0; k < ws->ns[n]; k++) ws->soft_Zl[n][k] = c * qp->Zl[n][ws->row_idx[n][ws->soft_of[n][k]]];
-        }
+        c = HM_R(1.0) / (mag < HM_R(1e-4) ? HM_R(1e-4) : (mag > HM_R(1e4) ? HM_R(1e4) : mag));
         ws->cost_scale = c;
         ws->norm_q = norm_q * c;
+        ws->norm_b = norm_b;
         ws->w_max = OCP_QP_IPM_W_MAX_REL * OCP_QP_IPM_MAX(HM_R(1.0), hscale * c);
     }
-    ws->norm_b = norm_b;
+
+    /* scaled cost, padding rows, starting point: v = 0 (soft slacks satisfying their rows with a
+     * margin of 1), y = 0, t = max(b - a' v, 1), z = 1 / t; zero step */
+    for (n = 0; n <= HM_N; n++) {
+        hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        for (i = 0; i < HM_NU * HM_NU; i++) sn->R[i] *= c;
+        for (i = 0; i < HM_NU * HM_NX; i++) sn->S[i] *= c;
+        for (i = 0; i < HM_NX * HM_NX; i++) sn->Q[i] *= c;
+        for (i = 0; i < HM_QP_NUX; i++) {
+            sn->q[i] *= c;
+            sn->ux[i] = HM_R(0.0);
+            sn->dux[i] = HM_R(0.0);
+        }
+        for (i = 0; i < HM_NX; i++) {
+            sn->y[i] = HM_R(0.0);
+            sn->dy[i] = HM_R(0.0);
+        }
+        for (k = 0; k < sn->nbp; k++) {
+            int l;
+            for (l = 0; l < 2; l++) {
+                const hm_real t = sn->bsg[k][l] != HM_R(0.0) ? OCP_QP_IPM_MAX(sn->bb[k][l], HM_R(1.0)) : HM_R(1.0);
+                sn->bt[k][l] = t;
+                sn->bz[k][l] = sn->bsg[k][l] != HM_R(0.0) ? HM_R(1.0) / t : HM_R(1.0);
+                sn->bdt[k][l] = HM_R(0.0);
+                sn->bdz[k][l] = HM_R(0.0);
+            }
+        }
+        for (j = 0; j < sn->ns; j++) {
+            const hm_real s = OCP_QP_IPM_MAX(HM_R(0.0), sn->slg[j]) + HM_R(1.0);
+            const hm_real t = OCP_QP_IPM_MAX(s - sn->slg[j], HM_R(1.0));
+            sn->szl[j] *= c;
+            sn->sZl[j] *= c;
+            sn->ss[j] = s;
+            sn->st[j] = t;
+            sn->sz[j] = HM_R(1.0) / t;
+            sn->szs[j] = HM_R(1.0) / s;
+        }
+        if (sn->ns & 1) {
+            /* the padding row: no coupling (d = 0), zero residuals at the state (1, 1, 1, 1), which
+             * pass A restores every iteration; its steps never shorten the step length */
+            j = sn->ns;
+            sn->sd0[j] = sn->sd1[j] = sn->slg[j] = HM_R(0.0);
+            sn->szl[j] = sn->sZl[j] = HM_R(1.0);
+            sn->slive[j] = HM_R(0.0);
+            sn->ss[j] = sn->st[j] = sn->sz[j] = sn->szs[j] = HM_R(1.0);
+        }
+        for (j = 0; j < sn->ns2; j++) sn->sds[j] = sn->sdt[j] = sn->sdz[j] = sn->sdzs[j] = HM_R(0.0);
+        for (j = 0; j < sn->nh; j++) {
+            const hm_real t = OCP_QP_IPM_MAX(-sn->hlg[j], HM_R(1.0));
+            sn->ht[j] = t;
+            sn->hz[j] = HM_R(1.0) / t;
+        }
+        if (sn->nh & 1) {
+            j = sn->nh;
+            sn->hd0[j] = sn->hd1[j] = HM_R(0.0);
+            sn->hlg[j] = HM_R(-1.0);
+            sn->hlive[j] = HM_R(0.0);
+            sn->ht[j] = sn->hz[j] = HM_R(1.0);
+        }
+        for (j = 0; j < sn->nh2; j++) sn->hdt[j] = sn->hdz[j] = HM_R(0.0);
+    }
     return 0;
 }
 
-/* y = c H_n x for the cost Hessian [R S'; S Q] of stage n on (u, x) and the cost scale c; parts
- * absent at stage 0 (x) and stage N (u) are zero in y and ignored in x. */
-HM_FUNC void ocp_qp_ipm_stage_hess_mul(const hm_ocp_qp *restrict qp, int n, hm_real c, const hm_real *restrict x,
-                                       hm_real *restrict y)
-{
-    int i, k;
-    if (n < HM_N) {
-        const hm_real *restrict R = qp->R[n];
-        y[0] = c * (R[0] * x[0] + R[2] * x[1]);
-        y[1] = c * (R[1] * x[0] + R[3] * x[1]);
-    } else {
-        y[0] = y[1] = HM_R(0.0);
-    }
-    if (n == 0) {
-        for (i = 0; i < HM_NX; i++) y[HM_NU + i] = HM_R(0.0);
-        return;
-    }
-    {
-        const hm_real *restrict Q = qp->Q[n];
-        hm_real yx[HM_NX] = {HM_R(0.0), HM_R(0.0), HM_R(0.0), HM_R(0.0)};
-        for (k = 0; k < HM_NX; k++) {
-            const hm_real xk = x[HM_NU + k];
-            for (i = 0; i < HM_NX; i++) yx[i] += Q[i + k * HM_NX] * xk;
-        }
-        if (n < HM_N) {
-            const hm_real *restrict S = qp->S[n];
-            hm_real su0 = HM_R(0.0), su1 = HM_R(0.0);
-            for (k = 0; k < HM_NX; k++) {
-                const hm_real *restrict sk = &S[k * HM_NU];
-                su0 += sk[0] * x[HM_NU + k];
-                su1 += sk[1] * x[HM_NU + k];
-                yx[k] += sk[0] * x[0] + sk[1] * x[1];
-            }
-            y[0] += c * su0;
-            y[1] += c * su1;
-        }
-        for (i = 0; i < HM_NX; i++) y[HM_NU + i] = c * yx[i];
-    }
-}
+/* ------------------------------------------------------------------------------------------------
+ * Pass A: step, residuals, weights, condensation
+ * ---------------------------------------------------------------------------------------------- */
 
 /* Scalars of one residual evaluation. */
 typedef struct {
@@ -226,162 +285,310 @@ typedef struct {
     hm_real atw, pv, av_eq, av_ineq;  /* inf-norms of A' w, P v, A_E v, A_I v + t */
     hm_real rd, rp;                   /* inf-norms of the dual and primal residuals */
     hm_real nv, nw, nt;               /* inf-norms of v, w, t */
+    hm_real ncr;                      /* max over inequalities of min(t, z) */
 } ocp_qp_ipm_sums;
 
-/* Residuals of the embedding at the point (v, t, tau, ws->kappa) into ws->rv:
- *   rv.ux, rv.s = P v + A' w + q tau,   rv.y = A_E v - b_E tau,   rv.z = A_I v + t - b_I tau,
- *   rtau = kappa + q' v + b' w + v' P v / tau,
- * the vector c = q + 2 P v / tau of the tau row, and the scalars of the termination tests. With
- * weights, also the row weights of the Newton matrix at this point (ws->w, ws->winv, ws->zinv). */
-HM_FUNC void ocp_qp_ipm_residuals(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws,
-                                  const hm_ocp_qp_ipm_vec *restrict v, const hm_real *restrict t, hm_real tau,
-                                  int weights, ocp_qp_ipm_sums *restrict sm)
+/* y = H_n x for the (scaled) cost Hessian [R S; S' Q] of stage n on (u, x); parts absent at stage 0
+ * (x) and stage N (u) are zero in the stage block and in x. */
+HM_FUNC void ocp_qp_ipm_hess_mul(const hm_ocp_qp_ipm_stage *restrict sn, const hm_real *restrict x,
+                                 hm_real *restrict y)
 {
-    hm_ocp_qp_ipm_vec *restrict r = &ws->rv;
-    const hm_real two_tinv = HM_R(2.0) / tau;
-    const hm_real w_max = ws->w_max;
+    const hm_real *restrict R = sn->R;
+    const hm_real *restrict S = sn->S;
+    const hm_real *restrict Q = sn->Q;
+    const hm_real u0 = x[0], u1 = x[1];
+    hm_real yx[HM_NX];
+    int i, k;
+    y[0] = R[0] * u0 + R[2] * u1;
+    y[1] = R[1] * u0 + R[3] * u1;
+    for (i = 0; i < HM_NX; i++) yx[i] = Q[i] * x[HM_NU];
+    for (k = 1; k < HM_NX; k++) {
+        const hm_real xk = x[HM_NU + k];
+        for (i = 0; i < HM_NX; i++) yx[i] += Q[i + k * HM_NX] * xk;
+    }
+    for (k = 0; k < HM_NX; k++) {
+        const hm_real *restrict sk = &S[k * HM_NU];
+        y[0] += sk[0] * x[HM_NU + k];
+        y[1] += sk[1] * x[HM_NU + k];
+        yx[k] += sk[0] * u0 + sk[1] * u1;
+    }
+    for (i = 0; i < HM_NX; i++) y[HM_NU + i] = yx[i];
+}
+
+HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha,
+                               ocp_qp_ipm_sums *restrict sm)
+{
+    const hm_real wmax = ws->w_max;
     hm_real qv = HM_R(0.0), bw = HM_R(0.0), vPv = HM_R(0.0), tz = HM_R(0.0);
     hm_real atw_n = HM_R(0.0), pv_n = HM_R(0.0), aveq_n = HM_R(0.0), avin_n = HM_R(0.0);
-    hm_real rd = HM_R(0.0), rp = HM_R(0.0), nv = HM_R(0.0), nw = HM_R(0.0), nt = HM_R(0.0);
-    int n, i, j, k;
+    hm_real rd = HM_R(0.0), rp = HM_R(0.0), nv = HM_R(0.0), nw = HM_R(0.0), nt = HM_R(0.0), ncr = HM_R(0.0);
+    int n, i, j, k, l;
 
     for (n = 0; n <= HM_N; n++) {
-        const hm_real *restrict ux = v->ux[n];
-        const hm_real *restrict qn = ws->q_ux[n];
-        const int off = ws->off[n];
-        const int nb = ws->nb[n];
-        const int base = off + nb;
-        const int nr = ws->nr[n];
-        const int ns = ws->ns[n];
+        hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+        hm_real *restrict ux = sn->ux;
         const int c0 = n == HM_N ? HM_NU : 0;
         const int c1 = n == 0 ? HM_NU : HM_QP_NUX;
-        hm_real Pux[HM_QP_NUX], atw[HM_QP_NUX];
+        hm_real Pux[HM_QP_NUX], atw[HM_QP_NUX], hf[HM_QP_NUX], hmu[HM_QP_NUX], Hd[HM_QP_NUX];
 
-        ocp_qp_ipm_stage_hess_mul(qp, n, ws->cost_scale, ux, Pux);
+        /* the step */
+        for (i = 0; i < HM_QP_NUX; i++) ux[i] += alpha * sn->dux[i];
+        if (n < HM_N) {
+            for (i = 0; i < HM_NX; i++) sn->y[i] += alpha * sn->dy[i];
+        }
 
-        /* A' w on (u, x): dynamics, bounds, general rows */
+        /* dynamics n - 1 -> n: x_n - A x_{n-1} - B u_{n-1} = b_{n-1} */
+        if (n > 0) {
+            hm_ocp_qp_ipm_stage *restrict sp = &ws->u.f.st[n - 1];
+            const hm_real *restrict A = qp->A[n - 1];
+            const hm_real *restrict B = qp->B[n - 1];
+            const hm_real *restrict up = sp->ux;
+            hm_real e[HM_NX];
+            for (i = 0; i < HM_NX; i++) e[i] = ux[HM_NU + i] - B[i] * up[0] - B[i + HM_NX] * up[1];
+            if (n > 1) {
+                for (k = 0; k < HM_NX; k++) {
+                    const hm_real xk = up[HM_NU + k];
+                    for (i = 0; i < HM_NX; i++) e[i] -= A[i + k * HM_NX] * xk;
+                }
+            }
+            for (i = 0; i < HM_NX; i++) {
+                const hm_real ri = e[i] - sp->beq[i];
+                sp->ry[i] = -ri;
+                aveq_n = OCP_QP_IPM_MAX(aveq_n, OCP_QP_IPM_ABS(e[i]));
+                rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_ABS(ri));
+            }
+        }
+
+        /* A_E' y */
         if (n < HM_N) {
             const hm_real *restrict B = qp->B[n];
-            const hm_real *restrict y = v->y[n];
+            const hm_real *restrict y = sn->y;
             atw[0] = -(B[0] * y[0] + B[1] * y[1] + B[2] * y[2] + B[3] * y[3]);
             atw[1] = -(B[4] * y[0] + B[5] * y[1] + B[6] * y[2] + B[7] * y[3]);
+            for (i = 0; i < HM_NX; i++) {
+                bw += sn->beq[i] * y[i];
+                nw = OCP_QP_IPM_MAX(nw, OCP_QP_IPM_ABS(y[i]));
+            }
         } else {
             atw[0] = atw[1] = HM_R(0.0);
         }
         if (n > 0) {
-            for (i = 0; i < HM_NX; i++) atw[HM_NU + i] = v->y[n - 1][i];
+            const hm_real *restrict ym = ws->u.f.st[n - 1].y;
+            for (i = 0; i < HM_NX; i++) atw[HM_NU + i] = ym[i];
             if (n < HM_N) {
                 const hm_real *restrict A = qp->A[n];
-                const hm_real *restrict y = v->y[n];
+                const hm_real *restrict y = sn->y;
                 for (i = 0; i < HM_NX; i++) {
                     const hm_real *restrict a = &A[i * HM_NX];
-                    atw[HM_NU + i] -= a[0] * y[0] + a[1] * y[1] + a[2] * y[2] + a[3] * y[3];
+                    atw[HM_NU + i] -= (a[0] * y[0] + a[1] * y[1]) + (a[2] * y[2] + a[3] * y[3]);
                 }
             }
         } else {
             for (i = 0; i < HM_NX; i++) atw[HM_NU + i] = HM_R(0.0);
         }
-        for (k = 0; k < nb; k++) {
-            const int c = ws->box_comp[n][k];
-            const hm_real sg = ws->box_sign[n][k];
-            atw[c] += sg * v->z[off + k];
-            r->z[off + k] = sg * ux[c] + t[off + k] - ws->b_ineq[off + k] * tau;
-        }
-        if (nr > 0) {
-            const hm_real p0 = ux[HM_NU], p1 = ux[HM_NU + 1];
-            hm_real a0 = HM_R(0.0), a1 = HM_R(0.0);
-            for (k = 0; k < nr; k++) {
-                const hm_real *restrict d = ws->D[n][k];
-                const hm_real zk = v->z[base + k];
-                a0 += d[0] * zk;
-                a1 += d[1] * zk;
-                r->z[base + k] = t[base + k] - (d[0] * p0 + d[1] * p1) - ws->b_ineq[base + k] * tau;
-                /* soft slack subtracted below */
-            }
-            atw[HM_NU] -= a0;
-            atw[HM_NU + 1] -= a1;
-        }
-        for (j = 0; j < ns; j++) {
-            const int jr = base + nr + j;
-            const int kr = ws->soft_of[n][j];
-            const hm_real s = v->s[n][kr];
-            const hm_real ps = ws->soft_Zl[n][j] * s;
-            const hm_real atws = -v->z[base + kr] - v->z[jr];
-            const hm_real rs = ps + atws + ws->q_s[n][kr] * tau;
-            r->s[n][kr] = rs;
-            ws->c_s[n][kr] = ws->q_s[n][kr] + two_tinv * ps;
-            r->z[base + kr] -= s;
-            r->z[jr] = t[jr] - s;
-            qv += ws->q_s[n][kr] * s;
-            vPv += ps * s;
-            atw_n = OCP_QP_IPM_MAX(atw_n, hm_fabs(atws));
-            pv_n = OCP_QP_IPM_MAX(pv_n, hm_fabs(ps));
-            rd = OCP_QP_IPM_MAX(rd, hm_fabs(rs));
-            nv = OCP_QP_IPM_MAX(nv, hm_fabs(s));
-        }
         for (i = 0; i < HM_QP_NUX; i++) {
-            const hm_real ri = Pux[i] + atw[i] + qn[i] * tau;
-            r->ux[n][i] = ri;
-            ws->c_ux[n][i] = qn[i] + two_tinv * Pux[i];
-        }
-        for (i = c0; i < c1; i++) {
-            qv += qn[i] * ux[i];
-            vPv += Pux[i] * ux[i];
-            atw_n = OCP_QP_IPM_MAX(atw_n, hm_fabs(atw[i]));
-            pv_n = OCP_QP_IPM_MAX(pv_n, hm_fabs(Pux[i]));
-            rd = OCP_QP_IPM_MAX(rd, hm_fabs(r->ux[n][i]));
-            nv = OCP_QP_IPM_MAX(nv, hm_fabs(ux[i]));
+            hf[i] = HM_R(0.0);
+            hmu[i] = HM_R(0.0);
+            Hd[i] = HM_R(0.0);
         }
 
-        /* dynamics rows x_{n+1} - A x_n - B u_n = b_n tau */
-        if (n < HM_N) {
-            const hm_real *restrict A = qp->A[n];
-            const hm_real *restrict B = qp->B[n];
-            const hm_real *restrict y = v->y[n];
-            hm_real e[HM_NX];
-            for (i = 0; i < HM_NX; i++) e[i] = v->ux[n + 1][HM_NU + i] - B[i] * ux[0] - B[i + HM_NX] * ux[1];
-            if (n > 0) {
-                for (k = 0; k < HM_NX; k++) {
-                    const hm_real xk = ux[HM_NU + k];
-                    for (i = 0; i < HM_NX; i++) e[i] -= A[i + k * HM_NX] * xk;
+        /* bound pairs: the two sides as two lanes */
+        for (k = 0; k < sn->nbp; k++) {
+            const int c = sn->bc[k];
+            const hm_real v = ux[c];
+            hm_real a_l[2], h_l[2], hf_l[2], mu_l[2];
+            for (l = 0; l < 2; l++) {
+                const hm_real sg = sn->bsg[k][l];
+                const hm_real msk = sg * sg;
+                const hm_real t = msk * (sn->bt[k][l] + alpha * sn->bdt[k][l]) + (HM_R(1.0) - msk);
+                const hm_real z = msk * (sn->bz[k][l] + alpha * sn->bdz[k][l]) + (HM_R(1.0) - msk);
+                const hm_real b = sn->bb[k][l];
+                const hm_real av = sg * v + t;
+                const hm_real r = av - b;
+                const hm_real inv = HM_R(1.0) / (t * z);
+                const hm_real ti = z * inv, zi = t * inv;
+                const hm_real w = OCP_QP_IPM_MIN(z * ti, wmax);
+                const hm_real rho = sg * v - b;
+                sn->bt[k][l] = t;
+                sn->bz[k][l] = z;
+                sn->bw[k][l] = w;
+                sn->bti[k][l] = ti;
+                sn->bzi[k][l] = zi;
+                sn->brho[k][l] = rho;
+                a_l[l] = sg * z;
+                h_l[l] = msk * w;
+                hf_l[l] = sg * w * rho;
+                mu_l[l] = sg * w * zi;
+                tz += msk * t * z;
+                ncr = OCP_QP_IPM_MAX(ncr, msk * OCP_QP_IPM_MIN(t, z));
+                rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_ABS(r));
+                avin_n = OCP_QP_IPM_MAX(avin_n, msk * OCP_QP_IPM_ABS(av));
+                nt = OCP_QP_IPM_MAX(nt, msk * t);
+                nw = OCP_QP_IPM_MAX(nw, msk * z);
+                bw += msk * b * z;
+            }
+            atw[c] += a_l[0] + a_l[1];
+            Hd[c] += h_l[0] + h_l[1];
+            hf[c] += hf_l[0] + hf_l[1];
+            hmu[c] += mu_l[0] + mu_l[1];
+        }
+
+        if (n > 0) {
+            const hm_real p0 = ux[HM_NU], p1 = ux[HM_NU + 1];
+            hm_real h00[2] = {HM_R(0.0), HM_R(0.0)}, h10[2] = {HM_R(0.0), HM_R(0.0)}, h11[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real g0[2] = {HM_R(0.0), HM_R(0.0)}, g1[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real m0[2] = {HM_R(0.0), HM_R(0.0)}, m1[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real a0[2] = {HM_R(0.0), HM_R(0.0)}, a1[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real tz_l[2] = {HM_R(0.0), HM_R(0.0)}, bw_l[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real qv_l[2] = {HM_R(0.0), HM_R(0.0)}, vPv_l[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real rp_l[2] = {HM_R(0.0), HM_R(0.0)}, rd_l[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real atw_l[2] = {HM_R(0.0), HM_R(0.0)}, pv_l[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real av_l[2] = {HM_R(0.0), HM_R(0.0)}, nv_l[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real nt_l[2] = {HM_R(0.0), HM_R(0.0)}, nw_l[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real nc_l[2] = {HM_R(0.0), HM_R(0.0)};
+
+            /* soft rows, in pairs */
+            for (j = 0; j < sn->ns2; j += 2) {
+                for (l = 0; l < 2; l++) {
+                    const int q = j + l;
+                    const hm_real msk = sn->slive[q];
+                    const hm_real s = msk * (sn->ss[q] + alpha * sn->sds[q]) + (HM_R(1.0) - msk);
+                    const hm_real t = msk * (sn->st[q] + alpha * sn->sdt[q]) + (HM_R(1.0) - msk);
+                    const hm_real z = msk * (sn->sz[q] + alpha * sn->sdz[q]) + (HM_R(1.0) - msk);
+                    const hm_real zs = msk * (sn->szs[q] + alpha * sn->sdzs[q]) + (HM_R(1.0) - msk);
+                    const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q], lg = sn->slg[q], Zl = sn->sZl[q];
+                    const hm_real gp = d0 * p0 + d1 * p1;
+                    const hm_real av = t - gp - s;
+                    const hm_real rr = av + lg;
+                    const hm_real rs = Zl * s + sn->szl[q] - z - zs;
+                    const hm_real ia = HM_R(1.0) / (t * z), ib = HM_R(1.0) / (s * zs);
+                    const hm_real ti = z * ia, zi = t * ia, si = zs * ib, zsi = s * ib;
+                    const hm_real wr = OCP_QP_IPM_MIN(z * ti, wmax), wsl = OCP_QP_IPM_MIN(zs * si, wmax);
+                    const hm_real hinv = HM_R(1.0) / (Zl + wr + wsl);
+                    const hm_real hw = hinv * wr;
+                    const hm_real we = hw * (Zl + wsl);
+                    const hm_real rho = lg - gp - s;
+                    const hm_real e = we * rho + hw * (rs + wsl * s);
+                    const hm_real cmu = we * zi - hw * wsl * zsi;
+                    const hm_real ast = z + zs;
+                    sn->ss[q] = s;
+                    sn->st[q] = t;
+                    sn->sz[q] = z;
+                    sn->szs[q] = zs;
+                    sn->sti[q] = ti;
+                    sn->szi[q] = zi;
+                    sn->ssi[q] = si;
+                    sn->szsi[q] = zsi;
+                    sn->swr[q] = wr;
+                    sn->sws[q] = wsl;
+                    sn->shi[q] = hinv;
+                    sn->srs[q] = rs;
+                    h00[l] += we * d0 * d0;
+                    h10[l] += we * d0 * d1;
+                    h11[l] += we * d1 * d1;
+                    g0[l] -= d0 * e;
+                    g1[l] -= d1 * e;
+                    m0[l] -= d0 * cmu;
+                    m1[l] -= d1 * cmu;
+                    a0[l] -= d0 * z;
+                    a1[l] -= d1 * z;
+                    tz_l[l] += msk * (t * z + s * zs);
+                    nc_l[l] = OCP_QP_IPM_MAX(nc_l[l], msk * OCP_QP_IPM_MAX(OCP_QP_IPM_MIN(t, z), OCP_QP_IPM_MIN(s, zs)));
+                    bw_l[l] -= msk * lg * z;
+                    qv_l[l] += msk * sn->szl[q] * s;
+                    vPv_l[l] += msk * Zl * s * s;
+                    rp_l[l] = OCP_QP_IPM_MAX(rp_l[l], OCP_QP_IPM_ABS(rr));
+                    rd_l[l] = OCP_QP_IPM_MAX(rd_l[l], OCP_QP_IPM_ABS(rs));
+                    atw_l[l] = OCP_QP_IPM_MAX(atw_l[l], msk * ast);
+                    pv_l[l] = OCP_QP_IPM_MAX(pv_l[l], msk * OCP_QP_IPM_ABS(Zl * s));
+                    av_l[l] = OCP_QP_IPM_MAX(av_l[l], msk * OCP_QP_IPM_ABS(av));
+                    nv_l[l] = OCP_QP_IPM_MAX(nv_l[l], msk * s);
+                    nt_l[l] = OCP_QP_IPM_MAX(nt_l[l], msk * t);
+                    nw_l[l] = OCP_QP_IPM_MAX(nw_l[l], msk * OCP_QP_IPM_MAX(z, zs));
                 }
             }
-            for (i = 0; i < HM_NX; i++) {
-                const hm_real bi = ws->b_eq[n][i];
-                const hm_real ri = e[i] - bi * tau;
-                r->y[n][i] = ri;
-                aveq_n = OCP_QP_IPM_MAX(aveq_n, hm_fabs(e[i]));
-                rp = OCP_QP_IPM_MAX(rp, hm_fabs(ri));
-                bw += bi * y[i];
-                nw = OCP_QP_IPM_MAX(nw, hm_fabs(y[i]));
+            /* hard rows, in pairs */
+            for (j = 0; j < sn->nh2; j += 2) {
+                for (l = 0; l < 2; l++) {
+                    const int q = j + l;
+                    const hm_real msk = sn->hlive[q];
+                    const hm_real t = msk * (sn->ht[q] + alpha * sn->hdt[q]) + (HM_R(1.0) - msk);
+                    const hm_real z = msk * (sn->hz[q] + alpha * sn->hdz[q]) + (HM_R(1.0) - msk);
+                    const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q], lg = sn->hlg[q];
+                    const hm_real gp = d0 * p0 + d1 * p1;
+                    const hm_real av = t - gp;
+                    const hm_real rr = av + lg;
+                    const hm_real ia = HM_R(1.0) / (t * z);
+                    const hm_real ti = z * ia, zi = t * ia;
+                    const hm_real w = OCP_QP_IPM_MIN(z * ti, wmax);
+                    const hm_real rho = lg - gp;
+                    const hm_real wr = w * rho, wz = w * zi;
+                    sn->ht[q] = t;
+                    sn->hz[q] = z;
+                    sn->hti[q] = ti;
+                    sn->hzi[q] = zi;
+                    sn->hw[q] = w;
+                    h00[l] += w * d0 * d0;
+                    h10[l] += w * d0 * d1;
+                    h11[l] += w * d1 * d1;
+                    g0[l] -= d0 * wr;
+                    g1[l] -= d1 * wr;
+                    m0[l] -= d0 * wz;
+                    m1[l] -= d1 * wz;
+                    a0[l] -= d0 * z;
+                    a1[l] -= d1 * z;
+                    tz_l[l] += msk * t * z;
+                    nc_l[l] = OCP_QP_IPM_MAX(nc_l[l], msk * OCP_QP_IPM_MIN(t, z));
+                    bw_l[l] -= msk * lg * z;
+                    rp_l[l] = OCP_QP_IPM_MAX(rp_l[l], OCP_QP_IPM_ABS(rr));
+                    av_l[l] = OCP_QP_IPM_MAX(av_l[l], msk * OCP_QP_IPM_ABS(av));
+                    nt_l[l] = OCP_QP_IPM_MAX(nt_l[l], msk * t);
+                    nw_l[l] = OCP_QP_IPM_MAX(nw_l[l], msk * z);
+                }
+            }
+            sn->Hpp[0] = h00[0] + h00[1];
+            sn->Hpp[1] = h10[0] + h10[1];
+            sn->Hpp[2] = h11[0] + h11[1];
+            hf[HM_NU] += g0[0] + g0[1];
+            hf[HM_NU + 1] += g1[0] + g1[1];
+            hmu[HM_NU] += m0[0] + m0[1];
+            hmu[HM_NU + 1] += m1[0] + m1[1];
+            atw[HM_NU] += a0[0] + a0[1];
+            atw[HM_NU + 1] += a1[0] + a1[1];
+            tz += tz_l[0] + tz_l[1];
+            bw += bw_l[0] + bw_l[1];
+            qv += qv_l[0] + qv_l[1];
+            vPv += vPv_l[0] + vPv_l[1];
+            rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_MAX(rp_l[0], rp_l[1]));
+            rd = OCP_QP_IPM_MAX(rd, OCP_QP_IPM_MAX(rd_l[0], rd_l[1]));
+            atw_n = OCP_QP_IPM_MAX(atw_n, OCP_QP_IPM_MAX(atw_l[0], atw_l[1]));
+            pv_n = OCP_QP_IPM_MAX(pv_n, OCP_QP_IPM_MAX(pv_l[0], pv_l[1]));
+            avin_n = OCP_QP_IPM_MAX(avin_n, OCP_QP_IPM_MAX(av_l[0], av_l[1]));
+            nv = OCP_QP_IPM_MAX(nv, OCP_QP_IPM_MAX(nv_l[0], nv_l[1]));
+            nt = OCP_QP_IPM_MAX(nt, OCP_QP_IPM_MAX(nt_l[0], nt_l[1]));
+            ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MAX(nc_l[0], nc_l[1]));
+            nw = OCP_QP_IPM_MAX(nw, OCP_QP_IPM_MAX(nw_l[0], nw_l[1]));
+        } else {
+            sn->Hpp[0] = sn->Hpp[1] = sn->Hpp[2] = HM_R(0.0);
+        }
+
+        /* stationarity of (u, x): r = P v + q + A' w, and the predictor's gradient r + A_I' W rho */
+        ocp_qp_ipm_hess_mul(sn, ux, Pux);
+        for (i = 0; i < HM_QP_NUX; i++) {
+            const hm_real ri = Pux[i] + sn->q[i] + atw[i];
+            sn->ha[i] = ri + hf[i];
+            sn->hmu[i] = hmu[i];
+            sn->Hd[i] = Hd[i];
+            if (i >= c0 && i < c1) {
+                qv += sn->q[i] * ux[i];
+                vPv += Pux[i] * ux[i];
+                atw_n = OCP_QP_IPM_MAX(atw_n, OCP_QP_IPM_ABS(atw[i]));
+                pv_n = OCP_QP_IPM_MAX(pv_n, OCP_QP_IPM_ABS(Pux[i]));
+                rd = OCP_QP_IPM_MAX(rd, OCP_QP_IPM_ABS(ri));
+                nv = OCP_QP_IPM_MAX(nv, OCP_QP_IPM_ABS(ux[i]));
             }
         }
     }
-    /* and, for the Newton matrix of this iterate, the row weights w = min(z / t, w_max), 1 / w and
-     * 1 / z, with one division per row */
-    for (j = 0; j < ws->m; j++) {
-        const hm_real zj = v->z[j], tj = t[j];
-        rp = OCP_QP_IPM_MAX(rp, hm_fabs(r->z[j]));
-        avin_n = OCP_QP_IPM_MAX(avin_n, hm_fabs(r->z[j] + ws->b_ineq[j] * tau));
-        bw += ws->b_ineq[j] * zj;
-        tz += tj * zj;
-        nw = OCP_QP_IPM_MAX(nw, zj);
-        nt = OCP_QP_IPM_MAX(nt, tj);
-    }
-    for (j = 0; weights && j < ws->m; j++) {
-        const hm_real zj = v->z[j], tj = t[j];
-        const hm_real inv = HM_R(1.0) / (tj * zj);
-        const hm_real wj = zj * zj * inv;
-        ws->zinv[j] = tj * inv;
-        if (wj < w_max) {
-            ws->w[j] = wj;
-            ws->winv[j] = tj * tj * inv;
-        } else {
-            ws->w[j] = w_max;
-            ws->winv[j] = HM_R(1.0) / w_max;
-        }
-    }
-    ws->rtau = ws->kappa + qv + bw + vPv / tau;
     sm->qv = qv;
     sm->bw = bw;
     sm->vPv = vPv;
@@ -395,162 +602,354 @@ HM_FUNC void ocp_qp_ipm_residuals(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
     sm->nv = nv;
     sm->nw = nw;
     sm->nt = nt;
+    sm->ncr = ncr;
 }
 
-/* The tau pivot of the Newton system, -kappa/tau + c' v1 + b' w1 - v' P v / tau^2 for the constant
- * solve (v1, w1). Evaluated in the equal form -kappa/tau - (v1 - v/tau)' P (v1 - v/tau) -
- * sum_j z1_j^2 / w_j, negative by construction: near the solution the first form cancels to rounding
- * noise and can even come out positive. */
-HM_FUNC hm_real ocp_qp_ipm_tau_pivot(const hm_ocp_qp *restrict qp, const hm_ocp_qp_ipm_ws *restrict ws,
-                                     hm_real tinv)
+/* ------------------------------------------------------------------------------------------------
+ * Passes B to E
+ * ---------------------------------------------------------------------------------------------- */
+
+/* Pass B: factorisation and the predictor's backward substitution. */
+HM_FUNC int ocp_qp_ipm_pass_b(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws)
 {
-    const hm_ocp_qp_ipm_vec *restrict v1 = &ws->v1;
-    const hm_ocp_qp_ipm_vec *restrict v = &ws->v;
-    hm_real acc = ws->kappa * tinv;
-    int n, i, j;
+    int n;
+    for (n = HM_N; n >= 0; n--) {
+        hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        const hm_ocp_qp_ipm_stage *sn1 = n < HM_N ? &ws->u.f.st[n + 1] : sn;
+        if (ocp_qp_kkt_factor_stage(qp, sn, sn1, n)) return HM_QP_NUMERICAL;
+        ocp_qp_kkt_backward_stage(qp, sn, sn1, n, sn->ha);
+    }
+    return 0;
+}
+
+/* Pass D: the corrector's backward substitution, gradient ha + hdl + smu * hmu. */
+HM_FUNC void ocp_qp_ipm_pass_d(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws, hm_real smu,
+                               hm_real kdel)
+{
+    int n, i;
+    for (n = HM_N; n >= 0; n--) {
+        hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        hm_real h[HM_QP_NUX];
+        for (i = 0; i < HM_QP_NUX; i++) h[i] = sn->ha[i] + kdel * sn->hdl[i] + smu * sn->hmu[i];
+        ocp_qp_kkt_backward_stage(qp, sn, n < HM_N ? &ws->u.f.st[n + 1] : sn, n, h);
+    }
+}
+
+/* Scalars of the predictor's forward pass. */
+typedef struct {
+    hm_real ratio;    /* max of -dt / t and -dz / z: the step to the boundary is 1 / max(1, ratio) */
+    hm_real tdz;      /* sum t dz + z dt */
+    hm_real dtdz;     /* sum dt dz */
+} ocp_qp_ipm_pred;
+
+/* The (u, x) step of stage n from the forward substitution: u (n < HM_N) and the carried state
+ * step x (zero at n = 0); returns the next state step in xn and the dynamics' multiplier step. */
+HM_FUNC void ocp_qp_ipm_stage_step(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws, int n,
+                                   hm_real *restrict dux, hm_real *restrict xn, hm_real *restrict dy)
+{
+    int i;
+    if (n < HM_N) {
+        hm_real u[HM_NU];
+        ocp_qp_kkt_forward_stage(qp, &ws->u.f.st[n], &ws->u.f.st[n + 1], n, &dux[HM_NU], u, xn, dy);
+        dux[0] = u[0];
+        dux[1] = u[1];
+    } else {
+        dux[0] = dux[1] = HM_R(0.0);
+        for (i = 0; i < HM_NX; i++) xn[i] = HM_R(0.0);
+    }
+}
+
+/* Pass C: the predictor's forward substitution and inequality steps; per inequality dt dz for the
+ * corrector, and per stage its second-order gradient terms hdl. */
+HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws,
+                               ocp_qp_ipm_pred *restrict pr)
+{
+    hm_real dux[HM_QP_NUX], xn[HM_NX], dy[HM_NX];
+    hm_real ratio = HM_R(0.0), tdz = HM_R(0.0), dtdz = HM_R(0.0);
+    int n, i, j, k, l;
+    for (i = 0; i < HM_QP_NUX; i++) dux[i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
-        hm_real d[HM_QP_NUX], Hd[HM_QP_NUX];
-        for (i = 0; i < HM_QP_NUX; i++) d[i] = v1->ux[n][i] - tinv * v->ux[n][i];
-        ocp_qp_ipm_stage_hess_mul(qp, n, ws->cost_scale, d, Hd);
-        for (i = 0; i < HM_QP_NUX; i++) acc += d[i] * Hd[i];
-        for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            const hm_real ds = v1->s[n][kr] - tinv * v->s[n][kr];
-            acc += ws->soft_Zl[n][j] * ds * ds;
+        hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+        hm_real hdl[HM_QP_NUX];
+        ocp_qp_ipm_stage_step(qp, ws, n, dux, xn, dy);
+        for (i = 0; i < HM_QP_NUX; i++) hdl[i] = HM_R(0.0);
+
+        for (k = 0; k < sn->nbp; k++) {
+            const int c = sn->bc[k];
+            const hm_real dv = dux[c];
+            hm_real h_l[2];
+            for (l = 0; l < 2; l++) {
+                const hm_real sg = sn->bsg[k][l], msk = sg * sg;
+                const hm_real t = sn->bt[k][l], z = sn->bz[k][l], w = sn->bw[k][l];
+                const hm_real ti = sn->bti[k][l], zi = sn->bzi[k][l];
+                const hm_real dz = w * (sg * dv + sn->brho[k][l]);
+#ifdef OCP_QP_IPM_DT_PRIMAL
+                const hm_real dt = -(sn->brho[k][l] + t) - sg * dv;
+#else
+                const hm_real dt = -t - t * dz * zi;
+#endif
+                const hm_real del = dt * dz;
+                sn->bdel[k][l] = del;
+                h_l[l] = sg * w * zi * del;
+                ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(-dt * ti, -dz * zi));
+                tdz += msk * (t * dz + z * dt);
+                dtdz += msk * del;
+            }
+            hdl[c] -= h_l[0] + h_l[1];
+        }
+        if (n > 0) {
+            const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
+            const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
+            hm_real g0[2] = {HM_R(0.0), HM_R(0.0)}, g1[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real ra[2] = {HM_R(0.0), HM_R(0.0)}, sa[2] = {HM_R(0.0), HM_R(0.0)}, sb[2] = {HM_R(0.0), HM_R(0.0)};
+            for (j = 0; j < sn->ns2; j += 2) {
+                for (l = 0; l < 2; l++) {
+                    const int q = j + l;
+                    const hm_real msk = sn->slive[q];
+                    const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q];
+                    const hm_real s = sn->ss[q], t = sn->st[q], z = sn->sz[q], zs = sn->szs[q];
+                    const hm_real wr = sn->swr[q], wsl = sn->sws[q], hinv = sn->shi[q];
+                    const hm_real zi = sn->szi[q], zsi = sn->szsi[q];
+                    const hm_real hw = hinv * wr, we = hw * (sn->sZl[q] + wsl);
+                    const hm_real gd = d0 * dp0 + d1 * dp1;
+                    const hm_real rho = sn->slg[q] - (d0 * p0 + d1 * p1) - s;
+                    const hm_real ds = hinv * (wr * rho - wsl * s - sn->srs[q]) - hw * gd;
+                    const hm_real dz = wr * (rho - gd - ds);
+                    const hm_real dzs = -wsl * (s + ds);
+#ifdef OCP_QP_IPM_DT_PRIMAL
+                    const hm_real dt = gd + ds - (t + rho);
+#else
+                    const hm_real dt = -t - t * dz * zi;
+#endif
+                    const hm_real dr = dt * dz, dsb = ds * dzs;
+                    const hm_real coef = we * zi * dr - hw * wsl * zsi * dsb;
+                    sn->sdr[q] = dr;
+                    sn->sdsb[q] = dsb;
+                    g0[l] += d0 * coef;
+                    g1[l] += d1 * coef;
+                    ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sn->sti[q], -dz * zi),
+                                                                  OCP_QP_IPM_MAX(-ds * sn->ssi[q], -dzs * zsi)));
+                    sa[l] += msk * (t * dz + z * dt + s * dzs + zs * ds);
+                    sb[l] += msk * (dr + dsb);
+                }
+            }
+            for (j = 0; j < sn->nh2; j += 2) {
+                for (l = 0; l < 2; l++) {
+                    const int q = j + l;
+                    const hm_real msk = sn->hlive[q];
+                    const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q];
+                    const hm_real t = sn->ht[q], z = sn->hz[q], w = sn->hw[q], zi = sn->hzi[q];
+                    const hm_real gd = d0 * dp0 + d1 * dp1;
+                    const hm_real rho = sn->hlg[q] - (d0 * p0 + d1 * p1);
+                    const hm_real dz = w * (rho - gd);
+#ifdef OCP_QP_IPM_DT_PRIMAL
+                    const hm_real dt = gd - (t + rho);
+#else
+                    const hm_real dt = -t - t * dz * zi;
+#endif
+                    const hm_real del = dt * dz;
+                    const hm_real coef = w * zi * del;
+                    sn->hdel[q] = del;
+                    g0[l] += d0 * coef;
+                    g1[l] += d1 * coef;
+                    ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hti[q], -dz * zi));
+                    sa[l] += msk * (t * dz + z * dt);
+                    sb[l] += msk * del;
+                }
+            }
+            hdl[HM_NU] += g0[0] + g0[1];
+            hdl[HM_NU + 1] += g1[0] + g1[1];
+            ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(ra[0], ra[1]));
+            tdz += sa[0] + sa[1];
+            dtdz += sb[0] + sb[1];
+        }
+        for (i = 0; i < HM_QP_NUX; i++) sn->hdl[i] = hdl[i];
+        for (i = 0; i < HM_NX; i++) dux[HM_NU + i] = xn[i];
+    }
+    pr->ratio = ratio;
+    pr->tdz = tdz;
+    pr->dtdz = dtdz;
+}
+
+/* Pass E: the corrector's forward substitution and inequality steps (stored: the step taken by the
+ * next pass A); returns the largest ratio -dt / t, -dz / z. */
+HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws, hm_real smu,
+                                  hm_real kdel)
+{
+    hm_real dux[HM_QP_NUX], xn[HM_NX];
+    hm_real ratio = HM_R(0.0);
+    int n, i, j, k, l;
+    for (i = 0; i < HM_QP_NUX; i++) dux[i] = HM_R(0.0);
+    for (n = 0; n <= HM_N; n++) {
+        hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+        ocp_qp_ipm_stage_step(qp, ws, n, dux, xn, sn->dy);
+        for (i = 0; i < HM_QP_NUX; i++) sn->dux[i] = dux[i];
+
+        for (k = 0; k < sn->nbp; k++) {
+            const int c = sn->bc[k];
+            const hm_real dv = dux[c];
+            for (l = 0; l < 2; l++) {
+                const hm_real sg = sn->bsg[k][l];
+                const hm_real t = sn->bt[k][l], z = sn->bz[k][l], w = sn->bw[k][l];
+                const hm_real ti = sn->bti[k][l], zi = sn->bzi[k][l], del = sn->bdel[k][l];
+                const hm_real cc = smu - kdel * del;
+                const hm_real dz = w * (sg * dv + sn->brho[k][l] + cc * zi);
+#ifdef OCP_QP_IPM_DT_PRIMAL
+                const hm_real dt = -(sn->brho[k][l] + t) - sg * dv;
+                (void)z;
+#else
+                const hm_real dt = -(t * z - cc + t * dz) * zi;
+#endif
+                sn->bdz[k][l] = dz;
+                sn->bdt[k][l] = dt;
+                ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(-dt * ti, -dz * zi));
+            }
+        }
+        if (n > 0) {
+            const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
+            const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
+            hm_real ra[2] = {HM_R(0.0), HM_R(0.0)};
+            for (j = 0; j < sn->ns2; j += 2) {
+                for (l = 0; l < 2; l++) {
+                    const int q = j + l;
+                    const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q];
+                    const hm_real s = sn->ss[q], t = sn->st[q], z = sn->sz[q];
+                    const hm_real wr = sn->swr[q], wsl = sn->sws[q], hinv = sn->shi[q];
+                    const hm_real zi = sn->szi[q], zsi = sn->szsi[q];
+                    const hm_real cr = smu - kdel * sn->sdr[q], cs = smu - kdel * sn->sdsb[q];
+                    const hm_real hw = hinv * wr;
+                    const hm_real gd = d0 * dp0 + d1 * dp1;
+                    const hm_real rho0 = sn->slg[q] - (d0 * p0 + d1 * p1) - s;
+                    const hm_real rho = rho0 + cr * zi;
+                    const hm_real rhos = cs * zsi - s;
+                    const hm_real ds = hinv * (wr * rho + wsl * rhos - sn->srs[q]) - hw * gd;
+                    const hm_real dz = wr * (rho - gd - ds);
+                    const hm_real dzs = wsl * (rhos - ds);
+#ifdef OCP_QP_IPM_DT_PRIMAL
+                    const hm_real dt = gd + ds - (t + rho0);
+                    (void)z;
+#else
+                    const hm_real dt = -(t * z - cr + t * dz) * zi;
+#endif
+                    sn->sds[q] = ds;
+                    sn->sdt[q] = dt;
+                    sn->sdz[q] = dz;
+                    sn->sdzs[q] = dzs;
+                    ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sn->sti[q], -dz * zi),
+                                                                  OCP_QP_IPM_MAX(-ds * sn->ssi[q], -dzs * zsi)));
+                }
+            }
+            for (j = 0; j < sn->nh2; j += 2) {
+                for (l = 0; l < 2; l++) {
+                    const int q = j + l;
+                    const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q];
+                    const hm_real t = sn->ht[q], z = sn->hz[q], w = sn->hw[q], zi = sn->hzi[q];
+                    const hm_real cc = smu - kdel * sn->hdel[q];
+                    const hm_real gd = d0 * dp0 + d1 * dp1;
+                    const hm_real rho0 = sn->hlg[q] - (d0 * p0 + d1 * p1);
+                    const hm_real dz = w * (rho0 + cc * zi - gd);
+#ifdef OCP_QP_IPM_DT_PRIMAL
+                    const hm_real dt = gd - (t + rho0);
+                    (void)z;
+#else
+                    const hm_real dt = -(t * z - cc + t * dz) * zi;
+#endif
+                    sn->hdz[q] = dz;
+                    sn->hdt[q] = dt;
+                    ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hti[q], -dz * zi));
+                }
+            }
+            ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(ra[0], ra[1]));
+        }
+        for (i = 0; i < HM_NX; i++) dux[HM_NU + i] = xn[i];
+    }
+    return ratio;
+}
+
+/* ------------------------------------------------------------------------------------------------
+ * Output
+ * ---------------------------------------------------------------------------------------------- */
+
+/* Multipliers and slacks of stage n into sol from the given inequality values (stage blocks or a
+ * vector); sc scales the multipliers, sp the slacks. */
+HM_FUNC void ocp_qp_ipm_write_stage(const hm_ocp_qp_ipm_stage *sn, int n, hm_ocp_qp_sol *sol,
+                                    const hm_real (*zb)[2], const hm_real *s, const hm_real *zr,
+                                    const hm_real *zs, const hm_real *zh, hm_real sc, hm_real sp)
+{
+    int i, k, j;
+    for (i = 0; i < HM_NG; i++) {
+        sol->s[n][i] = HM_R(0.0);
+        sol->lam_lg[n][i] = HM_R(0.0);
+        sol->lam_ls[n][i] = HM_R(0.0);
+    }
+    for (i = 0; i < HM_NX; i++) {
+        sol->lam_lbx[n][i] = HM_R(0.0);
+        sol->lam_ubx[n][i] = HM_R(0.0);
+    }
+    if (n < HM_N) {
+        for (i = 0; i < HM_NU; i++) {
+            sol->lam_lbu[n][i] = HM_R(0.0);
+            sol->lam_ubu[n][i] = HM_R(0.0);
         }
     }
-    for (j = 0; j < ws->m; j++) acc += v1->z[j] * v1->z[j] * ws->winv[j];
-    return -acc;
-}
-
-/* The step (ws->dv, ws->dt, ws->dtau, ws->dkappa) that leaves (1 - keep) of the residuals, for the
- * complementarity targets t o z + z o dt + t o dz = t o z - ds (ds in ws->ds) and
- * tau kappa + kappa dtau + tau dkappa = tau kappa - dk. den is the tau pivot of this factorisation.
- * Returns the largest alpha in (0, 1] with t, z, tau, kappa + alpha * step >= 0 (dividing only
- * where a row shortens the step). */
-HM_FUNC hm_real ocp_qp_ipm_direction(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws, hm_real keep,
-                                  hm_real dk, hm_real den)
-{
-    hm_ocp_qp_ipm_vec *restrict d = &ws->dv;
-    const hm_ocp_qp_ipm_vec *restrict r = &ws->rv;
-    const hm_ocp_qp_ipm_vec *restrict v1 = &ws->v1;
-    const hm_real tau = ws->tau;
-    hm_real dtau, a = HM_R(1.0);
-    int n, i, j;
-    for (n = 0; n <= HM_N; n++) {
-        for (i = 0; i < HM_QP_NUX; i++) d->ux[n][i] = -keep * r->ux[n][i];
-        for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            d->s[n][kr] = -keep * r->s[n][kr];
+    for (k = 0; k < sn->nbp; k++) {
+        const int c = sn->bc[k];
+        /* an absent side has sign 0: its multiplier is written as 0 */
+        const hm_real lo = sc * sn->bsg[k][0] * sn->bsg[k][0] * zb[k][0];
+        const hm_real up = sc * sn->bsg[k][1] * sn->bsg[k][1] * zb[k][1];
+        if (c < HM_NU) {
+            sol->lam_lbu[n][c] = lo;
+            sol->lam_ubu[n][c] = up;
+        } else {
+            sol->lam_lbx[n][c - HM_NU] = lo;
+            sol->lam_ubx[n][c - HM_NU] = up;
         }
     }
-    for (n = 0; n < HM_N; n++) {
-        for (i = 0; i < HM_NX; i++) d->y[n][i] = -keep * r->y[n][i];
+    for (j = 0; j < sn->ns; j++) {
+        const int i_row = sn->srow[j];
+        sol->s[n][i_row] = sp * s[j];
+        sol->lam_lg[n][i_row] = sc * zr[j];
+        sol->lam_ls[n][i_row] = sc * zs[j];
     }
-    for (j = 0; j < ws->m; j++) d->z[j] = ws->ds[j] * ws->zinv[j] - keep * r->z[j];
-    dtau = (dk / tau - keep * ws->rtau - ocp_qp_kkt_solve(qp, ws, d, d)) / den;
-    for (n = 0; n <= HM_N; n++) {
-        for (i = 0; i < HM_QP_NUX; i++) d->ux[n][i] += dtau * v1->ux[n][i];
-        for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            d->s[n][kr] += dtau * v1->s[n][kr];
-        }
-    }
-    for (n = 0; n < HM_N; n++) {
-        for (i = 0; i < HM_NX; i++) d->y[n][i] += dtau * v1->y[n][i];
-    }
-    ws->dtau = dtau;
-    ws->dkappa = -(dk + ws->kappa * dtau) / tau;
-    if (-ws->dtau * a > ws->tau) a = -ws->tau / ws->dtau;
-    if (-ws->dkappa * a > ws->kappa) a = -ws->kappa / ws->dkappa;
-    for (j = 0; j < ws->m; j++) {
-        const hm_real dz = d->z[j] + dtau * v1->z[j];
-        const hm_real tj = ws->t[j], zj = ws->v.z[j];
-        const hm_real dtj = -(ws->ds[j] + tj * dz) * ws->zinv[j];
-        d->z[j] = dz;
-        ws->dt[j] = dtj;
-        if (-dtj * a > tj) a = -tj / dtj;
-        if (-dz * a > zj) a = -zj / dz;
-    }
-    return a;
+    for (j = 0; j < sn->nh; j++) sol->lam_lg[n][sn->hrow[j]] = sc * zh[j];
 }
 
-/* Clarabel's shift of a starting vector into the interior of the nonnegative orthant. */
-HM_FUNC void ocp_qp_ipm_shift_interior(hm_real *x, int m)
+/* sol := the iterate with the primal part scaled by sp (1) and the multipliers by sc
+ * (1 / cost scale); or, with sp = 0, the certificate w scaled by sc (1 / -b'w). */
+HM_FUNC void ocp_qp_ipm_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, hm_ocp_qp_sol *sol,
+                                  hm_real sc, hm_real sp)
 {
-    hm_real mn = HM_INF, pos = HM_R(0.0), target;
-    int j;
-    if (m == 0) return;
-    for (j = 0; j < m; j++) {
-        mn = x[j] < mn ? x[j] : mn;
-        pos += OCP_QP_IPM_MAX(x[j], HM_R(0.0));
-    }
-    target = OCP_QP_IPM_MAX(HM_R(1.0), HM_R(0.1) * pos / (hm_real)m);
-    if (mn <= HM_R(0.0)) {
-        /* in two stages: x - mn + target in one go can round x_min to 0 when target << |mn| */
-        for (j = 0; j < m; j++) x[j] -= mn;
-        for (j = 0; j < m; j++) x[j] += target;
-    } else if (mn < target) {
-        for (j = 0; j < m; j++) x[j] += target - mn;
-    }
-}
-
-/* The right-hand side (-q, b) of the constant solve, into a. */
-HM_FUNC void ocp_qp_ipm_constant_rhs(const hm_ocp_qp_ipm_ws *restrict ws, hm_ocp_qp_ipm_vec *restrict a)
-{
-    int n, i, j;
-    for (n = 0; n <= HM_N; n++) {
-        for (i = 0; i < HM_QP_NUX; i++) a->ux[n][i] = -ws->q_ux[n][i];
-        for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            a->s[n][kr] = -ws->q_s[n][kr];
-        }
-    }
-    for (n = 0; n < HM_N; n++) {
-        for (i = 0; i < HM_NX; i++) a->y[n][i] = ws->b_eq[n][i];
-    }
-    for (j = 0; j < ws->m; j++) a->z[j] = ws->b_ineq[j];
-}
-
-/* sol := the point v (an iterate, or the polished solution) with the primal part scaled by sp
- * (1 / tau) and the multipliers by sc (1 / (tau * cost scale)); or, with sp = 0, the certificate
- * w scaled by sc (1 / -b'w). */
-HM_FUNC void ocp_qp_ipm_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_vec *v,
-                                  hm_ocp_qp_sol *sol, hm_real sc, hm_real sp)
-{
-    int n, i, j, k;
-    ocp_qp_sol_set_zero(sol);
+    int n, i;
     for (i = 0; i < HM_NX; i++) sol->x[0][i] = qp->x0[i];
     for (n = 0; n <= HM_N; n++) {
-        const int off = ws->off[n];
-        const int base = off + ws->nb[n];
-        const int nr = ws->nr[n];
+        const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
         if (n < HM_N) {
-            for (i = 0; i < HM_NU; i++) sol->u[n][i] = sp * v->ux[n][i];
+            for (i = 0; i < HM_NU; i++) sol->u[n][i] = sp * sn->ux[i];
+            for (i = 0; i < HM_NX; i++) sol->pi[n][i] = -sc * sn->y[i];
+        }
+        if (n > 0) {
+            for (i = 0; i < HM_NX; i++) sol->x[n][i] = sp * sn->ux[HM_NU + i];
+        }
+        ocp_qp_ipm_write_stage(sn, n, sol, (const hm_real (*)[2])sn->bz, sn->ss, sn->sz, sn->szs, sn->hz, sc, sp);
+    }
+}
+
+/* The same from a vector in the solver's layout (the polished solution). */
+HM_FUNC void ocp_qp_ipm_write_sol_vec(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws,
+                                      const hm_ocp_qp_ipm_vec *v, hm_ocp_qp_sol *sol, hm_real sc)
+{
+    int n, i;
+    for (i = 0; i < HM_NX; i++) sol->x[0][i] = qp->x0[i];
+    for (n = 0; n <= HM_N; n++) {
+        if (n < HM_N) {
+            for (i = 0; i < HM_NU; i++) sol->u[n][i] = v->ux[n][i];
             for (i = 0; i < HM_NX; i++) sol->pi[n][i] = -sc * v->y[n][i];
         }
         if (n > 0) {
-            for (i = 0; i < HM_NX; i++) sol->x[n][i] = sp * v->ux[n][HM_NU + i];
+            for (i = 0; i < HM_NX; i++) sol->x[n][i] = v->ux[n][HM_NU + i];
         }
-        for (k = 0; k < ws->nb[n]; k++) {
-            const int c = ws->box_comp[n][k];
-            const hm_real lam = sc * v->z[off + k];
-            const int upper = ws->box_sign[n][k] > HM_R(0.0);
-            if (c < HM_NU) {
-                if (upper) sol->lam_ubu[n][c] = lam;
-                else sol->lam_lbu[n][c] = lam;
-            } else {
-                if (upper) sol->lam_ubx[n][c - HM_NU] = lam;
-                else sol->lam_lbx[n][c - HM_NU] = lam;
-            }
-        }
-        for (k = 0; k < nr; k++) sol->lam_lg[n][ws->row_idx[n][k]] = sc * v->z[base + k];
-        for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            const int i_row = ws->row_idx[n][kr];
-            sol->s[n][i_row] = sp * v->s[n][kr];
-            sol->lam_ls[n][i_row] = sc * v->z[base + nr + j];
-        }
+        ocp_qp_ipm_write_stage(&ws->u.f.st[n], n, sol, (const hm_real (*)[2])v->zb[n], v->s[n], v->zr[n], v->zs[n],
+                               v->zh[n], sc, HM_R(1.0));
     }
 }
 
@@ -574,23 +973,128 @@ HM_FUNC void ocp_qp_ipm_write_box_certificate(const hm_ocp_qp *qp, hm_ocp_qp_sol
     }
 }
 
-/* Starting point (Clarabel's for QPs): (v, w) solving the Newton system with unit row weights for
- * the right-hand side (-q, b), i.e. the minimiser of the cost plus 1/2 ||A_I v - b_I||^2 under the
- * dynamics; then t = b_I - A_I v and z, each shifted into the interior; tau = kappa = 1. */
-HM_FUNC int ocp_qp_ipm_init(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws)
+/* Farkas test of the dual part w = (y, z) of a vector in the solver's layout: b' w < 0 and
+ * ||A' w||_inf <= tol_infeas * (-b' w) (z >= 0 is the caller's). Returns 1 if it passes, with b' w. */
+HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_vec *w,
+                              hm_real tol_infeas, hm_real *bw_out)
 {
-    int j;
-    for (j = 0; j < ws->m; j++) ws->w[j] = HM_R(1.0);
-    if (ocp_qp_kkt_factorize(qp, ws)) return HM_QP_NUMERICAL;
-    ocp_qp_ipm_constant_rhs(ws, &ws->v);
-    ocp_qp_kkt_solve(qp, ws, &ws->v, &ws->v);
-    for (j = 0; j < ws->m; j++) ws->t[j] = -ws->v.z[j];
-    ocp_qp_ipm_shift_interior(ws->t, ws->m);
-    ocp_qp_ipm_shift_interior(ws->v.z, ws->m);
-    ws->tau = HM_R(1.0);
-    ws->kappa = HM_R(1.0);
-    return 0;
+    hm_real bw = HM_R(0.0), atw_n = HM_R(0.0);
+    int n, i, k, j, l;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        const int c0 = n == HM_N ? HM_NU : 0;
+        const int c1 = n == 0 ? HM_NU : HM_QP_NUX;
+        hm_real atw[HM_QP_NUX];
+        for (i = 0; i < HM_QP_NUX; i++) atw[i] = HM_R(0.0);
+        if (n < HM_N) {
+            const hm_real *y = w->y[n];
+            for (i = 0; i < HM_NU; i++) atw[i] -= ocp_qp_kkt_dot4(qp->B[n] + i * HM_NX, y);
+            if (n > 0) {
+                for (i = 0; i < HM_NX; i++) atw[HM_NU + i] -= ocp_qp_kkt_dot4(qp->A[n] + i * HM_NX, y);
+            }
+            for (i = 0; i < HM_NX; i++) bw += sn->beq[i] * y[i];
+        }
+        if (n > 0) {
+            for (i = 0; i < HM_NX; i++) atw[HM_NU + i] += w->y[n - 1][i];
+        }
+        for (k = 0; k < sn->nbp; k++) {
+            for (l = 0; l < 2; l++) {
+                const hm_real sg = sn->bsg[k][l];
+                atw[sn->bc[k]] += sg * w->zb[n][k][l];
+                bw += sg * sg * sn->bb[k][l] * w->zb[n][k][l];
+            }
+        }
+        for (j = 0; j < sn->ns; j++) {
+            const hm_real as = OCP_QP_IPM_ABS(w->zr[n][j] + w->zs[n][j]);
+            atw[HM_NU] -= sn->sd0[j] * w->zr[n][j];
+            atw[HM_NU + 1] -= sn->sd1[j] * w->zr[n][j];
+            bw -= sn->slg[j] * w->zr[n][j];
+            atw_n = OCP_QP_IPM_MAX(atw_n, as);
+        }
+        for (j = 0; j < sn->nh; j++) {
+            atw[HM_NU] -= sn->hd0[j] * w->zh[n][j];
+            atw[HM_NU + 1] -= sn->hd1[j] * w->zh[n][j];
+            bw -= sn->hlg[j] * w->zh[n][j];
+        }
+        for (i = c0; i < c1; i++) atw_n = OCP_QP_IPM_MAX(atw_n, OCP_QP_IPM_ABS(atw[i]));
+    }
+    *bw_out = bw;
+    return bw < HM_R(0.0) && atw_n <= tol_infeas * -bw;
 }
+
+/* Test of the last step's primal direction d = (du, dx, ds) as a direction of unbounded descent:
+ * q' d < 0 and ||P d||, ||A_E d||, ||(A_I d)_+|| (inf-norms) <= tol_infeas * (-q' d), in the units
+ * of the data. Along such a d every feasible point can be improved without bound. */
+HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, hm_real tol_infeas)
+{
+    const hm_real cinv = HM_R(1.0) / ws->cost_scale;
+    hm_real qd = HM_R(0.0), pd = HM_R(0.0), ad = HM_R(0.0);
+    int n, i, k, j, l;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        const hm_real *d = sn->dux;
+        const int c0 = n == HM_N ? HM_NU : 0;
+        const int c1 = n == 0 ? HM_NU : HM_QP_NUX;
+        hm_real Pd[HM_QP_NUX];
+        ocp_qp_ipm_hess_mul(sn, d, Pd);
+        for (i = c0; i < c1; i++) {
+            qd += sn->q[i] * d[i];
+            pd = OCP_QP_IPM_MAX(pd, OCP_QP_IPM_ABS(Pd[i]));
+        }
+        if (n < HM_N) {
+            const hm_real *A = qp->A[n];
+            const hm_real *B = qp->B[n];
+            const hm_real *dn = &ws->u.f.st[n + 1].dux[HM_NU];
+            for (i = 0; i < HM_NX; i++) {
+                hm_real e = dn[i] - B[i] * d[0] - B[i + HM_NX] * d[1];
+                if (n > 0) {
+                    for (k = 0; k < HM_NX; k++) e -= A[i + k * HM_NX] * d[HM_NU + k];
+                }
+                ad = OCP_QP_IPM_MAX(ad, OCP_QP_IPM_ABS(e));
+            }
+        }
+        for (k = 0; k < sn->nbp; k++) {
+            for (l = 0; l < 2; l++) ad = OCP_QP_IPM_MAX(ad, sn->bsg[k][l] * d[sn->bc[k]]);
+        }
+        for (j = 0; j < sn->ns; j++) {
+            const hm_real gd = sn->sd0[j] * d[HM_NU] + sn->sd1[j] * d[HM_NU + 1];
+            qd += sn->szl[j] * sn->sds[j];
+            pd = OCP_QP_IPM_MAX(pd, OCP_QP_IPM_ABS(sn->sZl[j] * sn->sds[j]));
+            ad = OCP_QP_IPM_MAX(ad, OCP_QP_IPM_MAX(-(gd + sn->sds[j]), -sn->sds[j]));
+        }
+        for (j = 0; j < sn->nh; j++) ad = OCP_QP_IPM_MAX(ad, -(sn->hd0[j] * d[HM_NU] + sn->hd1[j] * d[HM_NU + 1]));
+    }
+    return qd < HM_R(0.0) && OCP_QP_IPM_MAX(pd * cinv, ad) <= tol_infeas * -qd * cinv;
+}
+
+/* The dual part of the last step's direction, its multiplier steps clipped at 0, into ws->u.f.va (primal
+ * part zero): when the multipliers diverge along a certificate, their steps point along it with
+ * less of the bounded part that the iterate carries. */
+HM_FUNC void ocp_qp_ipm_ray_from_step(hm_ocp_qp_ipm_ws *ws)
+{
+    hm_ocp_qp_ipm_vec *v = &ws->u.f.va;
+    int n, i, k, j, l;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        for (i = 0; i < HM_QP_NUX; i++) v->ux[n][i] = HM_R(0.0);
+        if (n < HM_N) {
+            for (i = 0; i < HM_NX; i++) v->y[n][i] = sn->dy[i];
+        }
+        for (k = 0; k < sn->nbp; k++) {
+            for (l = 0; l < 2; l++) v->zb[n][k][l] = OCP_QP_IPM_MAX(sn->bdz[k][l], HM_R(0.0));
+        }
+        for (j = 0; j < sn->ns; j++) {
+            v->s[n][j] = HM_R(0.0);
+            v->zr[n][j] = OCP_QP_IPM_MAX(sn->sdz[j], HM_R(0.0));
+            v->zs[n][j] = OCP_QP_IPM_MAX(sn->sdzs[j], HM_R(0.0));
+        }
+        for (j = 0; j < sn->nh; j++) v->zh[n][j] = OCP_QP_IPM_MAX(sn->hdz[j], HM_R(0.0));
+    }
+}
+
+/* ------------------------------------------------------------------------------------------------
+ * Active-set polish
+ * ---------------------------------------------------------------------------------------------- */
 
 /* The worst of the residuals of a solution, the measure by which a polished solution must improve. */
 HM_FUNC hm_real ocp_qp_ipm_res_worst(const hm_ocp_qp_res *res)
@@ -601,109 +1105,335 @@ HM_FUNC hm_real ocp_qp_ipm_res_worst(const hm_ocp_qp_res *res)
     return OCP_QP_IPM_MAX(a, res->dual);
 }
 
-/* Active-set polish (after OSQP's): rows whose slack is smaller than their multiplier are taken as
- * active and become equalities, the others are dropped, and the QP is solved on that active set. An
- * interior-point iterate stops at complementarity ~ tol, where a constraint that is active with a
- * zero multiplier (degenerate) keeps a slack of ~sqrt(tol); the polished point has none. The
- * equality-constrained system is solved by the Riccati factorisation with the active rows held by the
- * largest row weight and the dropped ones by a negligible one, plus two steps of iterative
- * refinement against the exact system, which remove both that penalty error and the rounding error
- * of the large weights. A degenerate row can be taken as active and come out with a (tiny) negative
- * multiplier: such rows are dropped and the solve repeated once. The result replaces the iterate
- * only if its worst KKT residual is smaller. Costs one or two factorisations, three solves each. */
-HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws)
+/* Residual of the Newton system with the polish's weights at (d, dz), as rhs - K d, written as
+ * e = -(K d - rhs) for the constant right-hand side (-q, b): e.ux = -(P v + q + A' w),
+ * e.y = -(A_E v - b_E), e.z = -(A_I v + t - b_I) with t = 0 on active inequalities and -dz / w on
+ * dropped ones (as factorised). */
+HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws,
+                                        const hm_ocp_qp_ipm_vec *d, hm_ocp_qp_ipm_vec *e)
 {
-    hm_ocp_qp_ipm_vec *d = &ws->dv;
-    hm_ocp_qp_ipm_vec *e = &ws->v1;
-    const hm_ocp_qp_ipm_vec *r = &ws->rv;
-    /* dropped rows keep a weight far below rounding level, not zero: a soft row's slack may have
-     * neither curvature nor an active bound, and its elimination divides by the sum of the three */
-    const hm_real w_drop = HM_EPS * HM_EPS / ws->w_max;
+    const hm_real wmax = ws->w_max;
+    int n, i, k, j, l;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        const hm_real *ux = d->ux[n];
+        hm_real r[HM_QP_NUX];
+        ocp_qp_ipm_hess_mul(sn, ux, r);
+        for (i = 0; i < HM_QP_NUX; i++) r[i] += sn->q[i];
+        if (n < HM_N) {
+            const hm_real *B = qp->B[n];
+            const hm_real *A = qp->A[n];
+            const hm_real *y = d->y[n];
+            hm_real ex[HM_NX];
+            for (i = 0; i < HM_NU; i++) r[i] -= ocp_qp_kkt_dot4(B + i * HM_NX, y);
+            if (n > 0) {
+                for (i = 0; i < HM_NX; i++) r[HM_NU + i] -= ocp_qp_kkt_dot4(A + i * HM_NX, y);
+            }
+            for (i = 0; i < HM_NX; i++) {
+                hm_real acc = d->ux[n + 1][HM_NU + i] - B[i] * ux[0] - B[i + HM_NX] * ux[1] - sn->beq[i];
+                if (n > 0) {
+                    for (k = 0; k < HM_NX; k++) acc -= A[i + k * HM_NX] * ux[HM_NU + k];
+                }
+                ex[i] = acc;
+            }
+            for (i = 0; i < HM_NX; i++) e->y[n][i] = -ex[i];
+        }
+        if (n > 0) {
+            for (i = 0; i < HM_NX; i++) r[HM_NU + i] += d->y[n - 1][i];
+        }
+        for (k = 0; k < sn->nbp; k++) {
+            const int c = sn->bc[k];
+            for (l = 0; l < 2; l++) {
+                const hm_real w = sn->bw[k][l];
+                const hm_real t = w < wmax ? -d->zb[n][k][l] / w : HM_R(0.0);
+                r[c] += sn->bsg[k][l] * d->zb[n][k][l];
+                e->zb[n][k][l] = -(sn->bsg[k][l] * ux[c] + t - sn->bb[k][l]);
+            }
+        }
+        for (j = 0; j < sn->ns; j++) {
+            const hm_real gp = sn->sd0[j] * ux[HM_NU] + sn->sd1[j] * ux[HM_NU + 1];
+            const hm_real tr = sn->swr[j] < wmax ? -d->zr[n][j] / sn->swr[j] : HM_R(0.0);
+            const hm_real ts = sn->sws[j] < wmax ? -d->zs[n][j] / sn->sws[j] : HM_R(0.0);
+            r[HM_NU] -= sn->sd0[j] * d->zr[n][j];
+            r[HM_NU + 1] -= sn->sd1[j] * d->zr[n][j];
+            e->s[n][j] = -(sn->sZl[j] * d->s[n][j] + sn->szl[j] - d->zr[n][j] - d->zs[n][j]);
+            e->zr[n][j] = -(tr - gp - d->s[n][j] + sn->slg[j]);
+            e->zs[n][j] = -(ts - d->s[n][j]);
+        }
+        for (j = 0; j < sn->nh; j++) {
+            const hm_real gp = sn->hd0[j] * ux[HM_NU] + sn->hd1[j] * ux[HM_NU + 1];
+            const hm_real t = sn->hw[j] < wmax ? -d->zh[n][j] / sn->hw[j] : HM_R(0.0);
+            r[HM_NU] -= sn->hd0[j] * d->zh[n][j];
+            r[HM_NU + 1] -= sn->hd1[j] * d->zh[n][j];
+            e->zh[n][j] = -(t - gp + sn->hlg[j]);
+        }
+        for (i = 0; i < HM_QP_NUX; i++) e->ux[n][i] = -r[i];
+    }
+}
+
+/* d += e over the parts of the vector in use */
+HM_FUNC void ocp_qp_ipm_vec_add(const hm_ocp_qp_ipm_ws *ws, hm_ocp_qp_ipm_vec *d, const hm_ocp_qp_ipm_vec *e)
+{
+    int n, i, k, j;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        for (i = 0; i < HM_QP_NUX; i++) d->ux[n][i] += e->ux[n][i];
+        if (n < HM_N) {
+            for (i = 0; i < HM_NX; i++) d->y[n][i] += e->y[n][i];
+        }
+        for (k = 0; k < sn->nbp; k++) {
+            d->zb[n][k][0] += e->zb[n][k][0];
+            d->zb[n][k][1] += e->zb[n][k][1];
+        }
+        for (j = 0; j < sn->ns; j++) {
+            d->s[n][j] += e->s[n][j];
+            d->zr[n][j] += e->zr[n][j];
+            d->zs[n][j] += e->zs[n][j];
+        }
+        for (j = 0; j < sn->nh; j++) d->zh[n][j] += e->zh[n][j];
+    }
+}
+
+/* The active-set update of one inequality after a polish solve with multiplier *z and slack
+ * `slack` (b - a' v): an active one (weight wmax) whose multiplier came out negative is dropped, a
+ * dropped one that the solution violates is made active (*changed = 1 either way), and a dropped one
+ * gets the multiplier 0. Returns the new weight. */
+HM_FUNC hm_real ocp_qp_ipm_polish_weight(hm_real w, hm_real *z, hm_real slack, hm_real wmax, hm_real w_drop,
+                                         int *changed)
+{
+    if (w < wmax) {
+        *z = HM_R(0.0);
+        if (slack < HM_R(0.0)) {
+            *changed = 1;
+            return wmax;
+        }
+        return w;
+    }
+    if (*z < HM_R(0.0)) {
+        *changed = 1;
+        return w_drop;
+    }
+    return w;
+}
+
+/* Whether an inequality with slack t and multiplier z, reached by the step alpha (dt, dz), looks
+ * active: by Tapia's indicators, the multiplier kept more of its value over the last step than the
+ * slack did (the slack of an active one falls to zero, its multiplier converges); without a step
+ * (alpha = 0), the slack is smaller than the multiplier. */
+HM_FUNC int ocp_qp_ipm_polish_active(hm_real t, hm_real z, hm_real dt, hm_real dz, hm_real alpha)
+{
+    const hm_real tp = t - alpha * dt, zp = z - alpha * dz;
+    if (alpha > HM_R(0.0) && tp > HM_R(0.0) && zp > HM_R(0.0)) return z * tp > t * zp;
+    return t < z;
+}
+
+/* Whether some inequality is undecided at the end of a solve: over the last step (alpha, dt, dz)
+ * neither its slack nor its multiplier fell below UNDEC of its value (a strictly complementary pair
+ * converges with one of them going to zero superlinearly; a degenerate one, both at a linear rate,
+ * which leaves the primal point sqrt(mu) away from the solution). */
+#ifndef OCP_QP_IPM_UNDEC
+#define OCP_QP_IPM_UNDEC HM_R(0.1)
+#endif
+HM_FUNC int ocp_qp_ipm_undecided_pair(hm_real t, hm_real z, hm_real dt, hm_real dz, hm_real alpha)
+{
+    const hm_real tp = t - alpha * dt, zp = z - alpha * dz;
+    return t > OCP_QP_IPM_UNDEC * tp && z > OCP_QP_IPM_UNDEC * zp;
+}
+
+HM_FUNC int ocp_qp_ipm_undecided(const hm_ocp_qp_ipm_ws *ws, hm_real alpha)
+{
+    int n, k, l, j;
+    if (!(alpha > HM_R(0.0))) return 0;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        for (k = 0; k < sn->nbp; k++) {
+            for (l = 0; l < 2; l++) {
+                if (sn->bsg[k][l] != HM_R(0.0)
+                    && ocp_qp_ipm_undecided_pair(sn->bt[k][l], sn->bz[k][l], sn->bdt[k][l], sn->bdz[k][l], alpha))
+                    return 1;
+            }
+        }
+        for (j = 0; j < sn->ns; j++) {
+            if (ocp_qp_ipm_undecided_pair(sn->st[j], sn->sz[j], sn->sdt[j], sn->sdz[j], alpha)
+                || ocp_qp_ipm_undecided_pair(sn->ss[j], sn->szs[j], sn->sds[j], sn->sdzs[j], alpha))
+                return 1;
+        }
+        for (j = 0; j < sn->nh; j++) {
+            if (ocp_qp_ipm_undecided_pair(sn->ht[j], sn->hz[j], sn->hdt[j], sn->hdz[j], alpha)) return 1;
+        }
+    }
+    return 0;
+}
+
+/* Active-set polish (after OSQP's): inequalities that look active (ocp_qp_ipm_polish_active) are
+ * taken as equalities, the others are dropped, and the QP is solved on that
+ * active set. An interior-point iterate stops at complementarity ~ tol, where a constraint that is
+ * active with a zero multiplier (degenerate) keeps a slack of ~sqrt(tol); the polished point has
+ * none. The equality-constrained system is solved by the Riccati factorisation with the active
+ * inequalities held by the largest weight and the dropped ones by a negligible one, plus two steps of
+ * iterative refinement against the exact system, which remove both that penalty error and the
+ * rounding error of the large weights. A degenerate inequality can be taken as active and come out
+ * with a (tiny) negative multiplier, or be taken as inactive and come out violated: such are moved
+ * to the other side and the solve repeated (at most six solves). The result replaces the iterate
+ * only if its worst KKT residual is smaller. */
+HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws, hm_real alpha)
+{
+    hm_ocp_qp_ipm_vec *d = &ws->u.f.va;
+    hm_ocp_qp_ipm_vec *e = &ws->u.f.vb;
+    const hm_real wmax = ws->w_max;
+    /* dropped inequalities keep a weight far below rounding level, not zero: a soft row's slack may
+     * have neither curvature nor an active bound, and its elimination divides by the sum of three */
+    const hm_real w_drop = HM_EPS * HM_EPS / wmax;
     const hm_real before = ocp_qp_ipm_res_worst(&ws->res);
     hm_ocp_qp_res res;
-    ocp_qp_ipm_sums sm;
-    int j, k, n, i, round, dropped = 1;
+    int n, i, k, j, l, round, changed = 1;
 
-    for (j = 0; j < ws->m; j++) ws->w[j] = ws->t[j] < ws->v.z[j] ? ws->w_max : w_drop;
-    for (round = 0; round < 2 && dropped; round++) {
-        if (ocp_qp_kkt_factorize(qp, ws)) return;
-        ocp_qp_ipm_constant_rhs(ws, d);
-        ocp_qp_kkt_solve(qp, ws, d, d);
-        for (k = 0; k < 2; k++) {
-            /* residual of the exact system: active rows a' v = b, dropped rows as factorised */
-            for (j = 0; j < ws->m; j++) ws->dt[j] = ws->w[j] < ws->w_max ? -d->z[j] / ws->w[j] : HM_R(0.0);
-            ocp_qp_ipm_residuals(qp, ws, d, ws->dt, HM_R(1.0), 0, &sm);
-            for (n = 0; n <= HM_N; n++) {
-                for (i = 0; i < HM_QP_NUX; i++) e->ux[n][i] = -r->ux[n][i];
-                for (j = 0; j < ws->ns[n]; j++) e->s[n][ws->soft_of[n][j]] = -r->s[n][ws->soft_of[n][j]];
+    for (n = 0; n <= HM_N; n++) {
+        hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        for (k = 0; k < sn->nbp; k++) {
+            for (l = 0; l < 2; l++) {
+                /* an absent side: dropped (its sign 0 keeps it out of the system anyway) */
+                const int act = sn->bsg[k][l] != HM_R(0.0)
+                                && ocp_qp_ipm_polish_active(sn->bt[k][l], sn->bz[k][l], sn->bdt[k][l], sn->bdz[k][l], alpha);
+                sn->bw[k][l] = act ? wmax : w_drop;
             }
-            for (n = 0; n < HM_N; n++) {
-                for (i = 0; i < HM_NX; i++) e->y[n][i] = -r->y[n][i];
-            }
-            for (j = 0; j < ws->m; j++) e->z[j] = -r->z[j];
-            ocp_qp_kkt_solve(qp, ws, e, e);
-            for (n = 0; n <= HM_N; n++) {
-                for (i = 0; i < HM_QP_NUX; i++) d->ux[n][i] += e->ux[n][i];
-                for (j = 0; j < ws->ns[n]; j++) d->s[n][ws->soft_of[n][j]] += e->s[n][ws->soft_of[n][j]];
-            }
-            for (n = 0; n < HM_N; n++) {
-                for (i = 0; i < HM_NX; i++) d->y[n][i] += e->y[n][i];
-            }
-            for (j = 0; j < ws->m; j++) d->z[j] += e->z[j];
         }
-        dropped = 0;
-        for (j = 0; j < ws->m; j++) {
-            if (ws->w[j] < ws->w_max) {
-                d->z[j] = HM_R(0.0);
-            } else if (d->z[j] < HM_R(0.0)) {
-                ws->w[j] = w_drop;
-                dropped = 1;
+        for (j = 0; j < sn->ns; j++) {
+            sn->swr[j] = ocp_qp_ipm_polish_active(sn->st[j], sn->sz[j], sn->sdt[j], sn->sdz[j], alpha) ? wmax : w_drop;
+            sn->sws[j] = ocp_qp_ipm_polish_active(sn->ss[j], sn->szs[j], sn->sds[j], sn->sdzs[j], alpha) ? wmax : w_drop;
+        }
+        for (j = 0; j < sn->nh; j++)
+            sn->hw[j] = ocp_qp_ipm_polish_active(sn->ht[j], sn->hz[j], sn->hdt[j], sn->hdz[j], alpha) ? wmax : w_drop;
+    }
+    for (round = 0; round < 6 && changed; round++) {
+        ocp_qp_kkt_condense_weights(ws);
+        if (ocp_qp_kkt_factorize(qp, ws)) {
+#ifdef OCP_QP_IPM_TRACE
+            printf("polish: factorisation failed\n");
+#endif
+            return;
+        }
+        /* the constant right-hand side (-q, b) */
+        for (n = 0; n <= HM_N; n++) {
+            const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+            for (i = 0; i < HM_QP_NUX; i++) e->ux[n][i] = -sn->q[i];
+            if (n < HM_N) {
+                for (i = 0; i < HM_NX; i++) e->y[n][i] = sn->beq[i];
+            }
+            for (k = 0; k < sn->nbp; k++) {
+                e->zb[n][k][0] = sn->bb[k][0];
+                e->zb[n][k][1] = sn->bb[k][1];
+            }
+            for (j = 0; j < sn->ns; j++) {
+                e->s[n][j] = -sn->szl[j];
+                e->zr[n][j] = -sn->slg[j];
+                e->zs[n][j] = HM_R(0.0);
+            }
+            for (j = 0; j < sn->nh; j++) e->zh[n][j] = -sn->hlg[j];
+        }
+        ocp_qp_kkt_solve(qp, ws, e, d);
+        for (k = 0; k < 2; k++) {
+            ocp_qp_ipm_polish_residual(qp, ws, d, e);
+            ocp_qp_kkt_solve(qp, ws, e, e);
+            ocp_qp_ipm_vec_add(ws, d, e);
+        }
+        changed = 0;
+        for (n = 0; n <= HM_N; n++) {
+            hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+            const hm_real *v = d->ux[n];
+            for (k = 0; k < sn->nbp; k++) {
+                for (l = 0; l < 2; l++) {
+                    const hm_real slack = sn->bb[k][l] - sn->bsg[k][l] * v[sn->bc[k]];
+                    sn->bw[k][l] = ocp_qp_ipm_polish_weight(sn->bw[k][l], &d->zb[n][k][l], slack, wmax, w_drop, &changed);
+                }
+            }
+            for (j = 0; j < sn->ns; j++) {
+                const hm_real g = sn->sd0[j] * v[HM_NU] + sn->sd1[j] * v[HM_NU + 1] + d->s[n][j] - sn->slg[j];
+                sn->swr[j] = ocp_qp_ipm_polish_weight(sn->swr[j], &d->zr[n][j], g, wmax, w_drop, &changed);
+                sn->sws[j] = ocp_qp_ipm_polish_weight(sn->sws[j], &d->zs[n][j], d->s[n][j], wmax, w_drop, &changed);
+            }
+            for (j = 0; j < sn->nh; j++) {
+                const hm_real g = sn->hd0[j] * v[HM_NU] + sn->hd1[j] * v[HM_NU + 1] - sn->hlg[j];
+                sn->hw[j] = ocp_qp_ipm_polish_weight(sn->hw[j], &d->zh[n][j], g, wmax, w_drop, &changed);
             }
         }
     }
-    ocp_qp_ipm_write_sol(qp, ws, d, sol, HM_R(1.0) / ws->cost_scale, HM_R(1.0));
+    ocp_qp_ipm_write_sol_vec(qp, ws, d, sol, HM_R(1.0) / ws->cost_scale);
     ocp_qp_res_compute(qp, sol, &res);
+#ifdef OCP_QP_IPM_TRACE
+    printf("polish: before %.3e after %.3e (stat %.2e eq %.2e ineq %.2e comp %.2e dual %.2e)\n", (double)before,
+           (double)ocp_qp_ipm_res_worst(&res), (double)res.stat, (double)res.eq, (double)res.ineq, (double)res.comp, (double)res.dual);
+#endif
     if (ocp_qp_ipm_res_worst(&res) < before) {
         ws->res = res;
         ws->polished = 1;
     } else {
-        ocp_qp_ipm_write_sol(qp, ws, &ws->v, sol, HM_R(1.0) / (ws->tau * ws->cost_scale), HM_R(1.0) / ws->tau);
+        ocp_qp_ipm_write_sol(qp, ws, sol, HM_R(1.0) / ws->cost_scale, HM_R(1.0));
     }
 }
+
+/* ------------------------------------------------------------------------------------------------
+ * The solve
+ * ---------------------------------------------------------------------------------------------- */
 
 /* Ends a solve: the solution, the certificate (with b' w = bw) or zeros (before the first iterate,
  * or for non-finite iterates) into sol, its residuals into ws->res. */
 HM_FUNC int ocp_qp_ipm_finish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws, int status,
-                              hm_real bw, int have_iterate, int polish)
+                              hm_real bw, int have_iterate, int polish, hm_real alpha)
 {
     if (status == HM_QP_INFEASIBLE) {
-        ocp_qp_ipm_write_sol(qp, ws, &ws->v, sol, HM_R(1.0) / -bw, HM_R(0.0));
+        ocp_qp_ipm_write_sol(qp, ws, sol, HM_R(1.0) / -bw, HM_R(0.0));
     } else if (status == HM_QP_NONFINITE || !have_iterate) {
         ocp_qp_sol_set_zero(sol);
     } else {
-        ocp_qp_ipm_write_sol(qp, ws, &ws->v, sol, HM_R(1.0) / (ws->tau * ws->cost_scale), HM_R(1.0) / ws->tau);
+        ocp_qp_ipm_write_sol(qp, ws, sol, HM_R(1.0) / ws->cost_scale, HM_R(1.0));
     }
     ocp_qp_res_compute(qp, sol, &ws->res);
-    if (status == HM_QP_SOLVED && polish) ocp_qp_ipm_polish(qp, sol, ws);
+    if (status == HM_QP_SOLVED && (polish == 1 || (polish == 2 && ocp_qp_ipm_undecided(ws, alpha))))
+        ocp_qp_ipm_polish(qp, sol, ws, alpha);
     ws->status = status;
+    return status;
+}
+
+/* Hands the QP over to the fallback solver (ocp_qp_hsde.h) with the iterations that are left, and
+ * reports its outcome as this solve's. */
+HM_FUNC int ocp_qp_ipm_fallback(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws,
+                                const hm_ocp_qp_ipm_arg *arg)
+{
+    hm_ocp_qp_ipm_arg a = *arg;
+    hm_ocp_qp_hsde_ws *h = &ws->u.hsde;
+    const int done = ws->iter;
+    int status;
+    a.max_iter = arg->max_iter - done;
+    status = ocp_qp_hsde_solve(qp, sol, h, &a);
+    ws->fallback = 1;
+    ws->status = status;
+    ws->iter = done + h->iter;
+    ws->res = h->res;
+    ws->res_primal = h->res_primal;
+    ws->res_dual = h->res_dual;
+    ws->gap = h->gap;
+    ws->mu = h->mu;
+    ws->unbounded = h->unbounded;
+    ws->polished = h->polished;
     return status;
 }
 
 HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws,
                              const hm_ocp_qp_ipm_arg *arg)
 {
-    int status, bad = 0, j;
+    int status, bad = 0, ray = 0, fallback = 0;
     ocp_qp_ipm_sums sm;
-    hm_real mu0 = HM_R(1.0);
+    hm_real mu0 = HM_R(1.0), alpha = HM_R(0.0), alpha_prev = HM_R(1.0), rp0 = HM_R(0.0);
 
     ws->iter = 0;
     ws->unbounded = 0;
     ws->polished = 0;
+    ws->fallback = 0;
     ws->res_primal = ws->res_dual = ws->gap = ws->mu = HM_R(0.0);
-    ws->tau = ws->kappa = HM_R(1.0);
 
     status = ocp_qp_check(qp);
-    if (status) return ocp_qp_ipm_finish(qp, sol, ws, status, HM_R(0.0), 0, 0);
+    if (status) return ocp_qp_ipm_finish(qp, sol, ws, status, HM_R(0.0), 0, 0, HM_R(0.0));
     status = ocp_qp_ipm_setup(qp, ws, &bad);
     if (status == HM_QP_INFEASIBLE) {
         ocp_qp_ipm_write_box_certificate(qp, sol, bad);
@@ -711,48 +1441,64 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         ws->status = status;
         return status;
     }
-    status = ocp_qp_ipm_init(qp, ws);
-    if (status) return ocp_qp_ipm_finish(qp, sol, ws, status, HM_R(0.0), 0, 0);
 
     for (;;) {
-        const hm_real mdeg = (hm_real)(ws->m + 1);
-        hm_real mu, tinv, res_p, res_d, pcost, gap, gap_rel, den, sigma, dk, alpha_aff, corr, frac, alpha;
+        const hm_real mdeg = ws->m > 0 ? (hm_real)ws->m : HM_R(1.0);
+        const hm_real cinv = HM_R(1.0) / ws->cost_scale;
+        hm_real mu, res_p, res_d, pcost, gap, gap_rel, sigma, smu, alpha_aff, mu_aff, frac, ratio;
+        ocp_qp_ipm_pred pr;
 
-        ocp_qp_ipm_residuals(qp, ws, &ws->v, ws->t, ws->tau, 1, &sm);
-        mu = (sm.tz + ws->tau * ws->kappa) / mdeg;
-        if (ws->iter == 0) mu0 = mu;
+        ocp_qp_ipm_pass_a(qp, ws, alpha, &sm);
+        mu = sm.tz / mdeg;
+        if (ws->iter == 0) {
+            mu0 = mu;
+            rp0 = sm.rp;
+        }
         ws->mu = mu;
-        if (!isfinite(mu + sm.rd + sm.rp + ws->rtau + sm.nv + sm.nw)) {
+        if (!isfinite(mu + sm.rd + sm.rp + sm.nv + sm.nw + sm.bw + sm.vPv)) {
             status = HM_QP_NONFINITE;
             break;
         }
 
-        /* termination tests on the QP point v / tau */
-        tinv = HM_R(1.0) / ws->tau;
-        res_p = sm.rp * tinv / OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_b + (sm.nv + sm.nt) * tinv);
-        res_d = sm.rd * tinv / OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_q + (sm.nv + sm.nw) * tinv);
-        /* the complementarity t' z of the QP point (= primal - dual cost once the residuals vanish,
-         * but without the cancellation of those two large numbers), absolute and relative to the
-         * cost, in the units of the data */
-        pcost = (sm.qv * tinv + HM_R(0.5) * sm.vPv * tinv * tinv) / ws->cost_scale;
-        gap = sm.tz * tinv * tinv / ws->cost_scale;
+        /* termination tests */
+        res_p = sm.rp / OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_b),
+                                       OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(sm.av_eq, sm.av_ineq), sm.nt));
+        res_d = sm.rd / OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_q), OCP_QP_IPM_MAX(sm.pv, sm.atw));
+        /* the complementarity t' z (= primal - dual cost once the residuals vanish, but without the
+         * cancellation of those two large numbers), absolute and relative to the cost, in the units
+         * of the data */
+        pcost = (sm.qv + HM_R(0.5) * sm.vPv) * cinv;
+        gap = sm.tz * cinv;
         gap_rel = gap / OCP_QP_IPM_MAX(HM_R(1.0), hm_fabs(pcost));
         ws->res_primal = res_p;
         ws->res_dual = res_d;
         ws->gap = gap_rel;
-        if (ws->kappa <= ws->tau && res_p <= arg->tol && res_d <= arg->tol
-            && (gap <= arg->tol || gap_rel <= arg->tol)) {
+        /* and the natural residual of complementarity, max min(t, z): the product t z bounds the
+         * distance to the solution only through its square root when a multiplier is small, the
+         * natural residual linearly; near-degenerate QPs need it, others meet it with the gap */
+        if (res_p <= arg->tol && res_d <= arg->tol && (gap <= arg->tol || gap_rel <= arg->tol)
+            && sm.ncr <= HM_R(10.0) * arg->tol) {
             status = HM_QP_SOLVED;
             break;
         }
-        if (ws->kappa > ws->tau) {
-            if (sm.bw < HM_R(0.0) && sm.atw <= arg->tol_infeas * -sm.bw) {
+        if (sm.bw < HM_R(0.0) && sm.atw <= arg->tol_infeas * -sm.bw) {
+            status = HM_QP_INFEASIBLE;
+            break;
+        }
+        if (ws->iter > 0 && alpha < HM_R(0.5)) {
+            hm_real bwr;
+            ocp_qp_ipm_ray_from_step(ws);
+            if (ocp_qp_ipm_farkas(qp, ws, &ws->u.f.va, arg->tol_infeas, &bwr)) {
                 status = HM_QP_INFEASIBLE;
+                ray = 1;
+                sm.bw = bwr;
                 break;
             }
-            const hm_real cinv = HM_R(1.0) / ws->cost_scale;
-            if (sm.qv < HM_R(0.0)
-                && OCP_QP_IPM_MAX(sm.pv * cinv, OCP_QP_IPM_MAX(sm.av_eq, sm.av_ineq)) <= arg->tol_infeas * -sm.qv * cinv) {
+        }
+        /* a stalling iteration (short steps) may be on a problem without solution: test the last
+         * step as a ray (ocp_qp_ipm_farkas, ocp_qp_ipm_unbounded_ray) */
+        if (ws->iter > 0 && alpha < HM_R(0.5)) {
+            if (ocp_qp_ipm_unbounded_ray(qp, ws, arg->tol_infeas)) {
                 ws->unbounded = 1;
                 status = HM_QP_NUMERICAL;
                 break;
@@ -765,7 +1511,20 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         /* the residuals have met their rounding floor above tol: going on only drives mu into
          * underflow and the iterates into noise */
         if (mu < mu0 * HM_EPS * HM_EPS) {
-            status = HM_QP_NUMERICAL;
+            fallback = 1;
+            break;
+        }
+        /* A stalling iteration (two short steps in a row), or residuals that do not fall with mu,
+         * is what an infeasible (or unbounded) problem does to this method when the certificate tests
+         * above have not caught it: hand over to the embedding, which handles those robustly. */
+        if (ws->iter > 1 && alpha < HM_R(0.1) && alpha_prev < HM_R(0.1)) {
+            fallback = 1;
+            break;
+        }
+        /* (only while the primal residual is above tol: once it is met, a residual that no longer
+         * falls is at its rounding floor, as single precision reaches with mu still falling) */
+        if (ws->iter > 1 && res_p > arg->tol && mu < HM_R(1e-2) * mu0 && sm.rp * mu0 > HM_R(1e3) * rp0 * mu) {
+            fallback = 1;
             break;
         }
         if (arg->should_stop && arg->should_stop(arg->stop_ctx)) {
@@ -774,63 +1533,75 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         }
         ws->iter++;
 
-        /* Newton matrix (weights from ocp_qp_ipm_residuals), and its solve for the constant right-hand
-         * side (v1, w1) = K^-1 (-q, b) */
-        if (ocp_qp_kkt_factorize(qp, ws)) {
+        alpha_prev = alpha;
+
+        /* predictor */
+        if (ocp_qp_ipm_pass_b(qp, ws)) {
+            /* singular at the start: the QP is not strictly convex in u; later: the weights of a
+             * diverging iteration */
+            if (ws->iter > 1) fallback = 1;
             status = HM_QP_NUMERICAL;
             break;
         }
-        ocp_qp_ipm_constant_rhs(ws, &ws->v1);
-        ocp_qp_kkt_solve(qp, ws, &ws->v1, &ws->v1);
-        den = ocp_qp_ipm_tau_pivot(qp, ws, tinv);
-        if (!(den < HM_R(0.0))) {
-            status = isfinite(den) ? HM_QP_NUMERICAL : HM_QP_NONFINITE;
-            break;
+        ocp_qp_ipm_pass_c(qp, ws, &pr);
+        alpha_aff = HM_R(1.0) / OCP_QP_IPM_MAX(HM_R(1.0), pr.ratio);
+        mu_aff = (sm.tz + alpha_aff * (pr.tdz + alpha_aff * pr.dtdz)) / mdeg;
+        sigma = mu > HM_R(0.0) ? mu_aff / mu : HM_R(0.0);
+        sigma = OCP_QP_IPM_MIN(OCP_QP_IPM_MAX(sigma, HM_R(0.0)), HM_R(1.0));
+        sigma = sigma * sigma * sigma;
+        smu = sigma * mu;
+
+        /* corrector */
+        ocp_qp_ipm_pass_d(qp, ws, smu, HM_R(1.0));
+        ratio = ocp_qp_ipm_pass_e(qp, ws, smu, HM_R(1.0));
+        if (ratio > HM_R(10.0)) {
+            /* a step below 0.1: the iterate is too far off the central path for Mehrotra's
+             * second-order term; solve again for a centring step without it (one more solve, rare) */
+            smu = OCP_QP_IPM_MAX(sigma, HM_R(0.5)) * mu;
+            ocp_qp_ipm_pass_d(qp, ws, smu, HM_R(0.0));
+            ratio = ocp_qp_ipm_pass_e(qp, ws, smu, HM_R(0.0));
         }
-
-        /* affine predictor */
-        for (j = 0; j < ws->m; j++) ws->ds[j] = ws->t[j] * ws->v.z[j];
-        alpha_aff = ocp_qp_ipm_direction(qp, ws, HM_R(1.0), ws->tau * ws->kappa, den);
-        sigma = (HM_R(1.0) - alpha_aff) * (HM_R(1.0) - alpha_aff) * (HM_R(1.0) - alpha_aff);
-
-        /* Mehrotra corrector, with only part of the second-order term in the first iteration, whose
-         * start may be far from central */
-        corr = ws->iter > 1 ? HM_R(1.0) : alpha_aff;
-        for (j = 0; j < ws->m; j++) ws->ds[j] += corr * ws->dt[j] * ws->dv.z[j] - sigma * mu;
-        dk = ws->tau * ws->kappa + corr * ws->dtau * ws->dkappa - sigma * mu;
-        alpha = ocp_qp_ipm_direction(qp, ws, HM_R(1.0) - sigma, dk, den);
 
         /* fraction to the boundary: arg->step_frac far from the solution, closer to 1 as mu falls
          * (relative to its start, so the rule does not depend on the data's units), which turns the
          * last iterations' linear rate 1 - step_frac into a superlinear one; never so close that t
          * or z could round to zero */
         frac = hm_fmin(HM_R(1.0) - mu / mu0, HM_R(1.0) - hm_sqrt(HM_EPS));
-        alpha *= OCP_QP_IPM_MAX(arg->step_frac, frac);
+        alpha = OCP_QP_IPM_MAX(arg->step_frac, frac) / OCP_QP_IPM_MAX(HM_R(1.0), ratio);
+#ifdef OCP_QP_IPM_STATS
+        {
+            extern double g_stat_min2alpha, g_stat_incons;
+            static double prev_alpha = 1.0, rp0 = 0.0;
+            const double a2 = (double)(alpha > prev_alpha ? alpha : prev_alpha);
+            if (ws->iter == 1) { prev_alpha = 1.0; rp0 = (double)sm.rp; g_stat_min2alpha = 1.0; g_stat_incons = 0.0; }
+            if (ws->iter > 1 && a2 < g_stat_min2alpha) g_stat_min2alpha = a2;
+            if (ws->iter > 1) {
+                const double inc = ((double)sm.rp / rp0) / ((double)mu / (double)mu0);
+                if ((double)mu / (double)mu0 < 1e-2 && inc > g_stat_incons) g_stat_incons = inc;
+            }
+            prev_alpha = (double)alpha;
+        }
+#endif
+#ifdef OCP_QP_IPM_TRACE
+        printf("it %2d mu %.3e res_p %.2e res_d %.2e gap %.2e gap_rel %.2e | a_aff %.4f sigma %.2e alpha %.6f bw %.2e atw %.2e\n",
+               ws->iter, (double)mu, (double)res_p, (double)res_d, (double)gap, (double)gap_rel, (double)alpha_aff,
+               (double)sigma, (double)alpha, (double)sm.bw, (double)sm.atw);
+#endif
         if (!(alpha >= arg->min_step)) {
-            status = isfinite(alpha) ? HM_QP_NUMERICAL : HM_QP_NONFINITE;
+            if (isfinite(alpha)) {
+                fallback = 1;
+            } else {
+                status = HM_QP_NONFINITE;
+            }
             break;
         }
-        {
-            hm_ocp_qp_ipm_vec *restrict v = &ws->v;
-            const hm_ocp_qp_ipm_vec *restrict dv = &ws->dv;
-            int n, i;
-            for (n = 0; n <= HM_N; n++) {
-                for (i = 0; i < HM_QP_NUX; i++) v->ux[n][i] += alpha * dv->ux[n][i];
-                for (j = 0; j < ws->ns[n]; j++) {
-                    const int kr = ws->soft_of[n][j];
-                    v->s[n][kr] += alpha * dv->s[n][kr];
-                }
-            }
-            for (n = 0; n < HM_N; n++) {
-                for (i = 0; i < HM_NX; i++) v->y[n][i] += alpha * dv->y[n][i];
-            }
-            for (j = 0; j < ws->m; j++) {
-                v->z[j] += alpha * dv->z[j];
-                ws->t[j] += alpha * ws->dt[j];
-            }
-        }
-        ws->tau += alpha * ws->dtau;
-        ws->kappa += alpha * ws->dkappa;
     }
-    return ocp_qp_ipm_finish(qp, sol, ws, status, sm.bw, 1, arg->polish);
+    if (fallback) return ocp_qp_ipm_fallback(qp, sol, ws, arg);
+    if (ray) {
+        ocp_qp_ipm_write_sol_vec(qp, ws, &ws->u.f.va, sol, HM_R(1.0) / -sm.bw);
+        ocp_qp_res_compute(qp, sol, &ws->res);
+        ws->status = status;
+        return status;
+    }
+    return ocp_qp_ipm_finish(qp, sol, ws, status, sm.bw, 1, arg->polish, alpha);
 }

@@ -2,39 +2,41 @@
  * ocp_qp_ipm.h: primal-dual interior-point solver (Mehrotra predictor-corrector) for ocp_qp, with
  * Riccati-factorised Newton systems (ocp_qp_kkt.h).
  *
- * Algorithm. The QP (hm_types.h) with primal v = (u, x, s), dynamics A_E v = b_E and inequality rows
- * A_I v + t = b_I, t >= 0, is solved through its homogeneous self-dual embedding (as in Clarabel,
- * Goulart & Chen 2024): unknowns (v, y, z, t, tau, kappa) with
- *     P v + A' (y, z) + q tau = 0,   A v + (0, t) = b tau,   kappa = -v' P v / tau - q' v - b' (y, z),
- *     z, t, tau, kappa >= 0 and complementary.
- * The cost is scaled by 1 / max(largest Hessian diagonal, largest gradient entry) (clipped to
- * [1e-4, 1e4]) so that tau and kappa balance cost against constraints whatever the units.
- * One iteration factorises the Newton matrix once (ocp_qp_kkt_factorize) and solves it three times:
- * a constant right-hand side (for the tau direction), the affine predictor, and the Mehrotra
- * corrector with centring sigma = (1 - alpha_affine)^3. The step is a fraction of the largest step
- * that keeps t, z, tau, kappa >= 0: arg->step_frac early, rising to 1 - mu/mu_0 late (never above
- * 1 - sqrt(eps)). The row weights z / t of the Newton matrix are capped (ocp_qp_ipm.c) so that the
- * Riccati recursion keeps its accuracy near the solution. The start is Clarabel's: one solve with
- * unit row weights for (-q, b), t and z shifted into the positive orthant, tau = kappa = 1.
+ * Algorithm. The QP (hm_types.h) with primal v = (u, x, s), dynamics A_E v = b_E and inequalities
+ * A_I v + t = b_I, t >= 0 (multipliers z >= 0) is solved by an infeasible-start primal-dual
+ * interior-point method: the iterate (v, y, z, t) with t, z > 0 follows the central path of
+ *     P v + q + A_E' y + A_I' z = 0,   A_E v = b_E,   A_I v + t = b_I,   t o z = mu.
+ * A soft row's slack s is the slack of its own bound s >= 0 (no second slack variable). The cost is
+ * scaled by 1 / max(largest Hessian diagonal, largest gradient entry) (clipped to [1e-4, 1e4]). The
+ * start is v = 0 (soft slacks just satisfying their rows, plus 1), y = 0, t = max(b_I - A_I v, 1),
+ * z = 1 / t. One iteration factorises the Newton matrix once (ocp_qp_kkt.h) and solves it twice:
+ * the affine predictor, and the Mehrotra corrector with centring sigma = (mu_aff / mu)^3. Both
+ * target the full primal and dual residuals; the step is a fraction of the largest step that keeps
+ * t, z >= 0: arg->step_frac early, rising to 1 - mu/mu_0 late (never above 1 - sqrt(eps)). The
+ * weights z / t of the Newton matrix are capped (ocp_qp_ipm.c) so that the Riccati recursion keeps
+ * its accuracy near the solution.
  *
  * Termination, checked at each iterate before the next factorisation:
- *   SOLVED      kappa <= tau, and with the QP point v / tau: primal and dual residuals (inf-norms),
- *               each divided by max(1, norms of the terms it is made of), and the complementarity
- *               t' z / tau^2 (the duality gap) in absolute terms or relative to max(1, |cost|), all
- *               below arg->tol. Then, with arg->polish, the active-set polish (ocp_qp_ipm.c): the QP
- *               solved once more as an equality-constrained QP on the rows the iterate has active,
- *               kept only if its worst KKT residual (ocp_qp_res_compute) is smaller (ws->polished).
- *   INFEASIBLE  kappa > tau and the dual iterate is a Farkas certificate: b' w < 0 and
- *               ||A' w||_inf <= tol_infeas * (-b' w), w = (y, z), z >= 0. Then every (u, x, s)
+ *   SOLVED      primal and dual residuals (inf-norms), each divided by max(1, norms of the terms it
+ *               is made of), and the complementarity t' z (the duality gap, in the units of the
+ *               data) in absolute terms or relative to max(1, |cost|), all below arg->tol. Then, with
+ *               arg->polish, the active-set polish (ocp_qp_ipm.c): the QP solved once more as an
+ *               equality-constrained QP on the rows the iterate has active, kept only if its worst
+ *               KKT residual (ocp_qp_res_compute) is smaller (ws->polished).
+ *   INFEASIBLE  the dual iterate is a Farkas certificate: b' w < 0 and ||A' w||_inf <=
+ *               tol_infeas * (-b' w), w = (y, z), z >= 0 (as every iterate's). Then every (u, x, s)
  *               satisfying the hard constraints has ||(u, x, s)||_1 >= 1 / tol_infeas: there is none
- *               of any practical size. Soft rows cannot take part (their z is forced to 0). The
- *               embedding drives tau -> 0 on infeasible problems at the rate it converges on feasible
- *               ones, so the certificate appears in a bounded number of iterations (measured: 7-28,
- *               typically 15). Contradictory bounds (lb > ub) are reported before any iteration.
+ *               of any practical size (sound whatever the iterates did before). On an infeasible
+ *               QP the method cannot reduce the primal residual, and the multipliers grow
+ *               geometrically along the certificate while A' w stays bounded by the cost terms, so
+ *               the test is met in a bounded number of iterations (measured on the tests' infeasible
+ *               QPs: 5-14, typically 8, the same as for feasible ones). Soft rows cannot take part
+ *               (their A' w entry -(z_row + z_slack) must vanish). Contradictory bounds (lb > ub)
+ *               are reported before any iteration.
  *   NUMERICAL   a pivot of the Riccati recursion is not safely positive, the step is below
  *               arg->min_step, mu fell below eps^2 mu_0 (the residuals are stuck at their rounding
- *               floor above tol), or a direction of unbounded descent was found (kappa > tau,
- *               q' v < 0 with P v, A_E v and A_I v + t small: ws->unbounded = 1; no minimiser).
+ *               floor above tol), or a direction of unbounded descent was found: q' v < 0 with
+ *               P v, A_E v - b_E... see ocp_qp_ipm.c (ws->unbounded = 1; no minimiser).
  *   NONFINITE   NaN or Inf in the data (checked before any work) or in the iterates.
  *   MAX_ITER / TIMEOUT  arg->max_iter iterations done / arg->should_stop returned nonzero (polled
  *               once per iteration, before its work).
@@ -51,10 +53,6 @@
 #define OCP_QP_IPM_H
 
 #include "hm_common.h"
-
-/* Inequality rows of one stage at most, and of the whole QP. */
-#define HM_QP_NC_STAGE (2 * (HM_NU + HM_NX) + 2 * HM_NG)
-#define HM_QP_NC_MAX ((HM_N + 1) * HM_QP_NC_STAGE)
 
 /* max_iter 50, tol 1e-6 (1e-4 in single precision), tol_infeas 1e-8 (1e-4), step_frac 0.99,
  * min_step 1e-8, no polish, no stop hook. */

@@ -3,93 +3,26 @@
  * (see ocp_qp_kkt.h).
  *
  * Stage n carries the variables (u_n, x_n) in this order, a 6-vector whose Hessian is
- * H_n = [R S'; S Q] (S is stored as the 2x4 block u-by-x) plus the row terms; stage 0 has only u_0
- * (x_0 is fixed) and stage N only x_N. The recursion keeps the cost-to-go 1/2 x' P_n x + p_n' x.
- * Eliminating u_n from H_n + [B A]' P_{n+1} [B A] is a partial Cholesky factorisation of that 6x6
- * matrix over its two u rows: the 2x2 factor Lr, the 2x4 block Y = Lr^-1 (S + B' P A), and the
- * Schur complement P_n = (Q + A' P A) - Y' Y, symmetric by construction.
+ * H_n = [R S; S' Q] (S is stored as the 2x4 block u-by-x) plus the condensed inequalities; stage 0
+ * has only u_0 (x_0 is fixed) and stage N only x_N. The recursion keeps the cost-to-go
+ * 1/2 x' P_n x + p_n' x. Eliminating u_n from H_n + [B A]' P_{n+1} [B A] is a partial LDL'
+ * factorisation of that 6x6 matrix over its two u rows: the 2x2 factor (1 / d0, l10, 1 / d1), the
+ * 2x4 block Kx = L^-1 (S + B' P A) and the Schur complement P_n = (Q + A' P A) - Kx' D^-1 Kx. LDL'
+ * rather than Cholesky: no square root on the recursion's critical path.
  *
  * The kernels are written for the fixed sizes (HM_NU = HM_NP = 2, HM_NX = 4): loops have
- * compile-time bounds and products are in axpy form over contiguous columns where possible.
+ * compile-time bounds and products are in axpy form over contiguous columns (2-wide SIMD).
  */
 #include "ocp_qp_kkt.h"
 
-/* Inverse square root of a pivot of the 2x2 input block, or -1 if the pivot is not positive beyond
- * the rounding noise of the diagonal it came from (`!(a > b)` also catches NaN). */
-HM_FUNC hm_real ocp_qp_kkt_pivot_inv(hm_real pivot, hm_real diag)
-{
-    if (!(pivot > HM_R(64.0) * HM_EPS * diag) || !(pivot > HM_R(0.0))) return HM_R(-1.0);
-    return HM_R(1.0) / hm_sqrt(pivot);
-}
-
-/* Lower triangle of the 6x6 stage matrix (column-major, u first) without the recursion term: cost
- * Hessian (times ws->cost_scale), bound weights on the diagonal, and every general row as w D D' on (px, py), where a soft
- * row with weight w_r, slack-bound weight w_s and slack Hessian Zl acts like a hard row of weight
- * w_r (Zl + w_s) / (Zl + w_r + w_s) (the two in series; written as a product, not as
- * w_r - w_r^2 / (...), which cancels when w_r is large). */
-HM_FUNC void ocp_qp_kkt_stage_matrix(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws, int n,
-                                     hm_real *restrict H)
-{
-    const hm_real *restrict w = ws->w;
-    const int off = ws->off[n];
-    const int nb = ws->nb[n];
-    const int base = off + nb;
-    const int nr = ws->nr[n];
-    const int ns = ws->ns[n];
-    const hm_real c = ws->cost_scale;
-    hm_real wrow[HM_NG > 0 ? HM_NG : 1];
-    int i, j, k;
-
-    if (n < HM_N) {
-        const hm_real *restrict R = qp->R[n];
-        H[0] = c * R[0];
-        H[1] = c * R[1];
-        H[1 + HM_QP_NUX] = c * R[3];
-        if (n > 0) {
-            const hm_real *restrict S = qp->S[n];
-            for (j = 0; j < HM_NU; j++) {
-                for (i = 0; i < HM_NX; i++) H[HM_NU + i + j * HM_QP_NUX] = c * S[j + i * HM_NU];
-            }
-        }
-    }
-    if (n > 0) {
-        const hm_real *restrict Q = qp->Q[n];
-        for (j = 0; j < HM_NX; j++) {
-            for (i = j; i < HM_NX; i++) H[HM_NU + i + (HM_NU + j) * HM_QP_NUX] = c * Q[i + j * HM_NX];
-        }
-        for (k = 0; k < nr; k++) wrow[k] = w[base + k];
-        for (j = 0; j < ns; j++) {
-            const int kr = ws->soft_of[n][j];
-            const hm_real Zl = ws->soft_Zl[n][j];
-            const hm_real wsl = w[base + nr + j];
-            const hm_real hinv = HM_R(1.0) / (Zl + wrow[kr] + wsl);
-            ws->soft_hinv[n][j] = hinv;
-            wrow[kr] *= (Zl + wsl) * hinv;
-        }
-        {
-            hm_real h00 = HM_R(0.0), h10 = HM_R(0.0), h11 = HM_R(0.0);
-            for (k = 0; k < nr; k++) {
-                const hm_real *restrict d = ws->D[n][k];
-                const hm_real wd0 = wrow[k] * d[0];
-                h00 += wd0 * d[0];
-                h10 += wd0 * d[1];
-                h11 += wrow[k] * d[1] * d[1];
-            }
-            H[HM_NU + HM_NU * HM_QP_NUX] += h00;
-            H[HM_NU + 1 + HM_NU * HM_QP_NUX] += h10;
-            H[HM_NU + 1 + (HM_NU + 1) * HM_QP_NUX] += h11;
-        }
-    }
-    for (k = 0; k < nb; k++) H[ws->box_comp[n][k] * (HM_QP_NUX + 1)] += w[off + k];
-}
-
-/* F = P M for the symmetric 4x4 P and the 4 x ncol matrix M, column by column in axpy form. */
-HM_FUNC void ocp_qp_kkt_mul_sym(const hm_real *restrict P, const hm_real *restrict M, hm_real *restrict F, int ncol)
+/* F = P M for the symmetric 4x4 P (stored in full) and the 4 x ncol matrix M, in axpy form. */
+HM_FUNC void ocp_qp_kkt_mul4(const hm_real *restrict P, const hm_real *restrict M, hm_real *restrict F, int ncol)
 {
     int i, j, k;
     for (j = 0; j < ncol; j++) {
-        hm_real f[HM_NX] = {HM_R(0.0), HM_R(0.0), HM_R(0.0), HM_R(0.0)};
-        for (k = 0; k < HM_NX; k++) {
+        hm_real f[HM_NX];
+        for (i = 0; i < HM_NX; i++) f[i] = P[i] * M[j * HM_NX];
+        for (k = 1; k < HM_NX; k++) {
             const hm_real mk = M[k + j * HM_NX];
             for (i = 0; i < HM_NX; i++) f[i] += P[i + k * HM_NX] * mk;
         }
@@ -102,72 +35,97 @@ HM_FUNC hm_real ocp_qp_kkt_dot4(const hm_real *restrict a, const hm_real *restri
     return (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
 }
 
-HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws)
+/* y = P x for the full 4x4 P */
+HM_FUNC void ocp_qp_kkt_mv4(const hm_real *restrict P, const hm_real *restrict x, hm_real *restrict y)
 {
-    hm_real H[HM_QP_NUX * HM_QP_NUX];
-    int n, i, j;
-
-    ocp_qp_kkt_stage_matrix(qp, ws, HM_N, H);
-    for (j = 0; j < HM_NX; j++) {
-        for (i = j; i < HM_NX; i++) {
-            const hm_real v = H[HM_NU + i + (HM_NU + j) * HM_QP_NUX];
-            ws->P[HM_N][i + j * HM_NX] = v;
-            ws->P[HM_N][j + i * HM_NX] = v;
-        }
+    int i, k;
+    for (i = 0; i < HM_NX; i++) y[i] = P[i] * x[0];
+    for (k = 1; k < HM_NX; k++) {
+        const hm_real xk = x[k];
+        for (i = 0; i < HM_NX; i++) y[i] += P[i + k * HM_NX] * xk;
     }
+}
 
-    for (n = HM_N - 1; n >= 0; n--) {
-        const hm_real *restrict Pn = ws->P[n + 1];
+HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn,
+                                    const hm_ocp_qp_ipm_stage *restrict sn1, int n)
+{
+    hm_real Hxx[HM_NX * HM_NX], Hxu[HM_NX * HM_NU];   /* column-major; Hxu column j for u_j */
+    hm_real h00 = HM_R(0.0), h10 = HM_R(0.0), h11 = HM_R(0.0);
+    int i, j, k;
+
+    if (n < HM_N) {
+        const hm_real *restrict P = sn1->P;
         const hm_real *restrict A = qp->A[n];
         const hm_real *restrict B = qp->B[n];
         hm_real FB[HM_NX * HM_NU];   /* P_{n+1} B */
-        hm_real *restrict L = ws->Lr[n];
-        hm_real l00, l10, piv;
-
-        ocp_qp_kkt_stage_matrix(qp, ws, n, H);
-        ocp_qp_kkt_mul_sym(Pn, B, FB, HM_NU);
-        for (j = 0; j < HM_NU; j++) {
-            for (i = j; i < HM_NU; i++) H[i + j * HM_QP_NUX] += ocp_qp_kkt_dot4(&B[i * HM_NX], &FB[j * HM_NX]);
-        }
+        ocp_qp_kkt_mul4(P, B, FB, HM_NU);
+        ocp_qp_kkt_mv4(P, sn->ry, sn->Pry);
+        h00 = sn->R[0] + sn->Hd[0] + ocp_qp_kkt_dot4(B, FB);
+        h10 = sn->R[1] + ocp_qp_kkt_dot4(B + HM_NX, FB);
+        h11 = sn->R[3] + sn->Hd[1] + ocp_qp_kkt_dot4(B + HM_NX, FB + HM_NX);
         if (n > 0) {
             hm_real FA[HM_NX * HM_NX];   /* P_{n+1} A */
-            ocp_qp_kkt_mul_sym(Pn, A, FA, HM_NX);
+            ocp_qp_kkt_mul4(P, A, FA, HM_NX);
+            /* A' F as sum over k of (row k of A)' times row k of F, column by column */
             for (j = 0; j < HM_NU; j++) {
-                for (i = 0; i < HM_NX; i++)
-                    H[HM_NU + i + j * HM_QP_NUX] += ocp_qp_kkt_dot4(&A[i * HM_NX], &FB[j * HM_NX]);
+                for (i = 0; i < HM_NX; i++) Hxu[i + j * HM_NX] = sn->S[j + i * HM_NU] + ocp_qp_kkt_dot4(A + i * HM_NX, FB + j * HM_NX);
             }
             for (j = 0; j < HM_NX; j++) {
-                for (i = j; i < HM_NX; i++)
-                    H[HM_NU + i + (HM_NU + j) * HM_QP_NUX] += ocp_qp_kkt_dot4(&A[i * HM_NX], &FA[j * HM_NX]);
+                for (i = 0; i < HM_NX; i++) {
+                    hm_real acc = sn->Q[i + j * HM_NX];
+                    for (k = 0; k < HM_NX; k++) acc += A[k + i * HM_NX] * FA[k + j * HM_NX];
+                    Hxx[i + j * HM_NX] = acc;
+                }
             }
         }
+    } else {
+        for (i = 0; i < HM_NX * HM_NX; i++) Hxx[i] = sn->Q[i];
+    }
+    if (n > 0) {
+        for (i = 0; i < HM_NX; i++) Hxx[i * (HM_NX + 1)] += sn->Hd[HM_NU + i];
+        Hxx[0] += sn->Hpp[0];
+        Hxx[1] += sn->Hpp[1];
+        Hxx[HM_NX] += sn->Hpp[1];
+        Hxx[HM_NX + 1] += sn->Hpp[2];
+        if (n == HM_N) {
+            for (i = 0; i < HM_NX * HM_NX; i++) sn->P[i] = Hxx[i];
+            return 0;
+        }
+    }
 
-        /* partial Cholesky over the u rows; a pivot that is not safely positive means the QP is not
-         * strictly convex in u along the current active set */
-        if (!(H[0] > HM_R(0.0))) return HM_QP_NUMERICAL;
-        l00 = hm_sqrt(H[0]);
-        L[0] = HM_R(1.0) / l00;
-        l10 = H[1] * L[0];
-        L[1] = l10;
-        piv = H[1 + HM_QP_NUX] - l10 * l10;
-        L[2] = ocp_qp_kkt_pivot_inv(piv, H[1 + HM_QP_NUX]);
-        if (L[2] < HM_R(0.0)) return HM_QP_NUMERICAL;
-        if (n == 0) break;
+    /* partial LDL' over the u rows; a pivot that is not safely positive means the QP is not strictly
+     * convex in u along the current active set (`!(a > b)` also catches NaN) */
+    {
+        hm_real id0, l10, d1, id1;
+        if (!(h00 > HM_R(0.0))) return HM_QP_NUMERICAL;
+        id0 = HM_R(1.0) / h00;
+        l10 = h10 * id0;
+        d1 = h11 - l10 * h10;
+        if (!(d1 > HM_R(64.0) * HM_EPS * h11) || !(d1 > HM_R(0.0))) return HM_QP_NUMERICAL;
+        id1 = HM_R(1.0) / d1;
+        sn->Ld[0] = id0;
+        sn->Ld[1] = l10;
+        sn->Ld[2] = id1;
+        if (n == 0) return 0;
         {
-            hm_real *restrict Y = ws->Y[n];
-            hm_real *restrict P = ws->P[n];
-            for (j = 0; j < HM_NX; j++) {
-                const hm_real y0 = H[HM_NU + j] * L[0];
-                Y[0 + j * HM_NU] = y0;
-                Y[1 + j * HM_NU] = (H[HM_NU + j + HM_QP_NUX] - l10 * y0) * L[2];
+            hm_real *restrict K0 = sn->Kx;
+            hm_real *restrict K1 = sn->Kx + HM_NX;
+            hm_real *restrict Pn = sn->P;
+            hm_real k0s[HM_NX], k1s[HM_NX];
+            for (i = 0; i < HM_NX; i++) {
+                const hm_real a0 = Hxu[i], a1 = Hxu[i + HM_NX] - l10 * Hxu[i];
+                K0[i] = a0;
+                K1[i] = a1;
+                k0s[i] = a0 * id0;
+                k1s[i] = a1 * id1;
             }
+            /* P_n = Hxx - K0 K0' / d0 - K1 K1' / d1, symmetric by construction (lower triangle
+             * mirrored: Hxx is symmetric only up to rounding) */
             for (j = 0; j < HM_NX; j++) {
-                const hm_real yj0 = Y[0 + j * HM_NU], yj1 = Y[1 + j * HM_NU];
                 for (i = j; i < HM_NX; i++) {
-                    const hm_real v = H[HM_NU + i + (HM_NU + j) * HM_QP_NUX] - Y[0 + i * HM_NU] * yj0
-                                      - Y[1 + i * HM_NU] * yj1;
-                    P[i + j * HM_NX] = v;
-                    P[j + i * HM_NX] = v;
+                    const hm_real v = Hxx[i + j * HM_NX] - k0s[i] * K0[j] - k1s[i] * K1[j];
+                    Pn[i + j * HM_NX] = v;
+                    Pn[j + i * HM_NX] = v;
                 }
             }
         }
@@ -175,187 +133,194 @@ HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws 
     return 0;
 }
 
-/* Gradient of the equality-constrained stage QP that is left after eliminating dz and the soft
- * slacks: h_n = -(rhs_v + A_I' W rhs_z) on (u, x), with the soft slacks folded in (their step at a
- * zero position step is kept in ws->soft_e for ocp_qp_kkt_expand). */
-HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_ws *restrict ws,
-                                 const hm_ocp_qp_ipm_vec *rhs, int n, hm_real *restrict h)
+HM_FUNC void ocp_qp_kkt_backward_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn,
+                                       const hm_ocp_qp_ipm_stage *restrict sn1, int n, const hm_real *restrict h)
 {
-    const hm_real *restrict w = ws->w;
-    const hm_real *rz = rhs->z;
-    const int off = ws->off[n];
-    const int nb = ws->nb[n];
-    const int base = off + nb;
-    const int nr = ws->nr[n];
-    const int ns = ws->ns[n];
-    int i, j, k;
-    for (i = 0; i < HM_QP_NUX; i++) h[i] = -rhs->ux[n][i];
-    for (k = 0; k < nb; k++) h[ws->box_comp[n][k]] -= ws->box_sign[n][k] * w[off + k] * rz[off + k];
-    if (nr > 0) {
-        hm_real coef[HM_NG > 0 ? HM_NG : 1];   /* the multiple of D of each row in h_p */
-        hm_real hp0 = HM_R(0.0), hp1 = HM_R(0.0);
-        for (k = 0; k < nr; k++) coef[k] = w[base + k] * rz[base + k];
-        for (j = 0; j < ns; j++) {
-            const int jr = base + nr + j;
-            const int kr = ws->soft_of[n][j];
-            const hm_real e = (rhs->s[n][kr] - coef[kr] - w[jr] * rz[jr]) * ws->soft_hinv[n][j];
-            ws->soft_e[n][j] = e;
-            coef[kr] += w[base + kr] * e;
-        }
-        for (k = 0; k < nr; k++) {
-            const hm_real *restrict d = ws->D[n][k];
-            hp0 += coef[k] * d[0];
-            hp1 += coef[k] * d[1];
-        }
-        h[HM_NU] += hp0;
-        h[HM_NU + 1] += hp1;
+    int i;
+    if (n == HM_N) {
+        for (i = 0; i < HM_NX; i++) sn->p[i] = h[HM_NU + i];
+        return;
     }
-}
-
-/* dz of the rows of stage n and the soft slack steps, from the (u, x) step of the stage. Reads each
- * entry of rhs before it writes the same entry of sol, so the two may be one vector. */
-HM_FUNC void ocp_qp_kkt_expand(const hm_ocp_qp_ipm_ws *restrict ws,
-                               const hm_ocp_qp_ipm_vec *rhs, hm_ocp_qp_ipm_vec *sol, int n)
-{
-    const hm_real *restrict w = ws->w;
-    const hm_real *dux = sol->ux[n];
-    const int off = ws->off[n];
-    const int nb = ws->nb[n];
-    const int base = off + nb;
-    const int nr = ws->nr[n];
-    const int ns = ws->ns[n];
-    hm_real gd[HM_NG > 0 ? HM_NG : 1];   /* -(D' dp + ds) of each general row */
-    int j, k;
-    for (k = 0; k < nb; k++) {
-        const int c = ws->box_comp[n][k];
-        sol->z[off + k] = w[off + k] * (ws->box_sign[n][k] * dux[c] - rhs->z[off + k]);
-    }
-    if (nr == 0) return;
     {
-        const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
-        for (k = 0; k < nr; k++) {
-            const hm_real *restrict d = ws->D[n][k];
-            gd[k] = -(d[0] * dp0 + d[1] * dp1);
-        }
-    }
-    for (j = 0; j < ns; j++) {
-        const int jr = base + nr + j;
-        const int kr = ws->soft_of[n][j];
-        const hm_real dsl = ws->soft_e[n][j] + w[base + kr] * ws->soft_hinv[n][j] * gd[kr];
-        sol->s[n][kr] = dsl;
-        sol->z[jr] = w[jr] * (-dsl - rhs->z[jr]);
-        gd[kr] -= dsl;
-    }
-    for (k = 0; k < nr; k++) sol->z[base + k] = w[base + k] * (gd[k] - rhs->z[base + k]);
-}
-
-/* The part of stage n of c' sol_v + b' sol_w, the tau row of the interior-point Newton system, with
- * c = (ws->c_ux, ws->c_s) and b = (ws->b_eq, ws->b_ineq); evaluated while the stage is in cache. */
-HM_FUNC hm_real ocp_qp_kkt_tau_row(const hm_ocp_qp_ipm_ws *restrict ws, const hm_ocp_qp_ipm_vec *sol, int n)
-{
-    const int off = ws->off[n];
-    const int nc = ws->nb[n] + ws->nr[n] + ws->ns[n];
-    hm_real acc = HM_R(0.0);
-    int i, j;
-    for (i = 0; i < HM_QP_NUX; i++) acc += ws->c_ux[n][i] * sol->ux[n][i];
-    for (j = 0; j < ws->ns[n]; j++) {
-        const int kr = ws->soft_of[n][j];
-        acc += ws->c_s[n][kr] * sol->s[n][kr];
-    }
-    if (n < HM_N) {
-        for (i = 0; i < HM_NX; i++) acc += ws->b_eq[n][i] * sol->y[n][i];
-    }
-    for (j = off; j < off + nc; j++) acc += ws->b_ineq[j] * sol->z[j];
-    return acc;
-}
-
-HM_FUNC hm_real ocp_qp_kkt_solve(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws,
-                                 const hm_ocp_qp_ipm_vec *rhs, hm_ocp_qp_ipm_vec *sol)
-{
-    hm_real cdot = HM_R(0.0);
-    int n, i, k;
-
-    /* backward: cost-to-go gradients p_n and the input terms yk_n = Lr^-1 (reduced input gradient) */
-    {
-        hm_real h[HM_QP_NUX];
-        ocp_qp_kkt_condense(ws, rhs, HM_N, h);
-        for (i = 0; i < HM_NX; i++) ws->p[HM_N][i] = h[HM_NU + i];
-    }
-    for (n = HM_N - 1; n >= 0; n--) {
-        const hm_real *restrict Pn = ws->P[n + 1];
         const hm_real *restrict A = qp->A[n];
         const hm_real *restrict B = qp->B[n];
-        const hm_real *restrict L = ws->Lr[n];
-        const hm_real *ry = rhs->y[n];
-        hm_real h[HM_QP_NUX], pb[HM_NX], rb0, rb1, y0, y1;
-        ocp_qp_kkt_condense(ws, rhs, n, h);
-        for (i = 0; i < HM_NX; i++) pb[i] = ws->p[n + 1][i];
-        for (k = 0; k < HM_NX; k++) {
-            const hm_real rk = ry[k];
-            for (i = 0; i < HM_NX; i++) pb[i] += Pn[i + k * HM_NX] * rk;
-        }
-        rb0 = h[0] + B[0] * pb[0] + B[1] * pb[1] + B[2] * pb[2] + B[3] * pb[3];
-        rb1 = h[1] + B[4] * pb[0] + B[5] * pb[1] + B[6] * pb[2] + B[7] * pb[3];
-        y0 = rb0 * L[0];
-        y1 = (rb1 - L[1] * y0) * L[2];
-        ws->yk[n][0] = y0;
-        ws->yk[n][1] = y1;
+        const hm_real *restrict L = sn->Ld;
+        hm_real pb[HM_NX], y0, y1;
+        for (i = 0; i < HM_NX; i++) pb[i] = sn1->p[i] + sn->Pry[i];
+        y0 = h[0] + ocp_qp_kkt_dot4(B, pb);
+        y1 = h[1] + ocp_qp_kkt_dot4(B + HM_NX, pb) - L[1] * y0;
+        sn->yk[0] = y0;
+        sn->yk[1] = y1;
         if (n > 0) {
-            const hm_real *restrict Y = ws->Y[n];
-            hm_real *restrict p = ws->p[n];
-            for (i = 0; i < HM_NX; i++) {
-                const hm_real *restrict a = &A[i * HM_NX];
-                p[i] = h[HM_NU + i] + a[0] * pb[0] + a[1] * pb[1] + a[2] * pb[2] + a[3] * pb[3]
-                       - Y[0 + i * HM_NU] * y0 - Y[1 + i * HM_NU] * y1;
-            }
+            const hm_real c0 = y0 * L[0], c1 = y1 * L[2];
+            const hm_real *restrict K0 = sn->Kx;
+            const hm_real *restrict K1 = sn->Kx + HM_NX;
+            for (i = 0; i < HM_NX; i++)
+                sn->p[i] = h[HM_NU + i] + ocp_qp_kkt_dot4(A + i * HM_NX, pb) - K0[i] * c0 - K1[i] * c1;
         }
     }
+}
 
-    /* forward: u_n = -Lr^-T (Y x_n + yk_n), x_{n+1} = A x_n + B u_n + rhs_y, dy_n = -(P x + p) */
+HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp_qp_ipm_stage *restrict sn,
+                                      const hm_ocp_qp_ipm_stage *restrict sn1, int n, const hm_real *restrict x,
+                                      hm_real *restrict u, hm_real *restrict xn, hm_real *restrict dy)
+{
+    const hm_real *restrict A = qp->A[n];
+    const hm_real *restrict B = qp->B[n];
+    const hm_real *restrict L = sn->Ld;
+    hm_real w0 = sn->yk[0], w1 = sn->yk[1], v0, v1, xnew[HM_NX], t[HM_NX];
+    int i, k;
+    if (n > 0) {
+        w0 += ocp_qp_kkt_dot4(sn->Kx, x);
+        w1 += ocp_qp_kkt_dot4(sn->Kx + HM_NX, x);
+    }
+    v1 = w1 * L[2];
+    v0 = w0 * L[0] - L[1] * v1;
+    u[0] = -v0;
+    u[1] = -v1;
+    for (i = 0; i < HM_NX; i++) xnew[i] = sn->ry[i] - B[i] * v0 - B[i + HM_NX] * v1;
+    if (n > 0) {
+        for (k = 0; k < HM_NX; k++) {
+            const hm_real xk = x[k];
+            for (i = 0; i < HM_NX; i++) xnew[i] += A[i + k * HM_NX] * xk;
+        }
+    }
+    ocp_qp_kkt_mv4(sn1->P, xnew, t);
+    for (i = 0; i < HM_NX; i++) {
+        xn[i] = xnew[i];
+        dy[i] = -(t[i] + sn1->p[i]);
+    }
+}
+
+/* ------------------------------------------------------------------------------------------------
+ * The general system
+ * ---------------------------------------------------------------------------------------------- */
+
+HM_FUNC void ocp_qp_kkt_condense_weights(hm_ocp_qp_ipm_ws *ws)
+{
+    int n, k, j;
+    for (n = 0; n <= HM_N; n++) {
+        hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        hm_real h00 = HM_R(0.0), h10 = HM_R(0.0), h11 = HM_R(0.0);
+        for (k = 0; k < HM_QP_NUX; k++) sn->Hd[k] = HM_R(0.0);
+        for (k = 0; k < sn->nbp; k++) {
+            const int c = sn->bc[k];
+            sn->Hd[c] += sn->bsg[k][0] * sn->bsg[k][0] * sn->bw[k][0] + sn->bsg[k][1] * sn->bsg[k][1] * sn->bw[k][1];
+        }
+        for (j = 0; j < sn->ns; j++) {
+            /* a soft row with weight wr, slack-bound weight ws and slack Hessian Zl acts like a hard
+             * row of weight wr (Zl + ws) / (Zl + wr + ws) (the two in series; as a product, not as
+             * wr - wr^2 / (...), which cancels when wr is large) */
+            const hm_real hinv = HM_R(1.0) / (sn->sZl[j] + sn->swr[j] + sn->sws[j]);
+            const hm_real we = sn->swr[j] * (sn->sZl[j] + sn->sws[j]) * hinv;
+            const hm_real wd0 = we * sn->sd0[j];
+            sn->shi[j] = hinv;
+            h00 += wd0 * sn->sd0[j];
+            h10 += wd0 * sn->sd1[j];
+            h11 += we * sn->sd1[j] * sn->sd1[j];
+        }
+        for (j = 0; j < sn->nh; j++) {
+            const hm_real wd0 = sn->hw[j] * sn->hd0[j];
+            h00 += wd0 * sn->hd0[j];
+            h10 += wd0 * sn->hd1[j];
+            h11 += sn->hw[j] * sn->hd1[j] * sn->hd1[j];
+        }
+        sn->Hpp[0] = h00;
+        sn->Hpp[1] = h10;
+        sn->Hpp[2] = h11;
+    }
+}
+
+HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws)
+{
+    int n;
+    for (n = HM_N; n >= 0; n--) {
+        if (ocp_qp_kkt_factor_stage(qp, &ws->u.f.st[n], n < HM_N ? &ws->u.f.st[n + 1] : &ws->u.f.st[n], n))
+            return HM_QP_NUMERICAL;
+    }
+    return 0;
+}
+
+/* Gradient of the condensed stage QP for a general right-hand side: h = -(rhs_v + A_I' W rhs_z)
+ * with the soft slacks folded in (their step at a zero position step into e). */
+HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_vec *rhs, int n, hm_real *h)
+{
+    hm_real hp0 = HM_R(0.0), hp1 = HM_R(0.0);
+    int i, k, j;
+    for (i = 0; i < HM_QP_NUX; i++) h[i] = -rhs->ux[n][i];
+    for (k = 0; k < sn->nbp; k++) {
+        const int c = sn->bc[k];
+        h[c] -= sn->bsg[k][0] * sn->bw[k][0] * rhs->zb[n][k][0] + sn->bsg[k][1] * sn->bw[k][1] * rhs->zb[n][k][1];
+    }
+    for (j = 0; j < sn->ns; j++) {
+        hm_real coef = sn->swr[j] * rhs->zr[n][j];
+        const hm_real ej = (rhs->s[n][j] - coef - sn->sws[j] * rhs->zs[n][j]) * sn->shi[j];
+        sn->se[j] = ej;
+        coef += sn->swr[j] * ej;
+        hp0 += coef * sn->sd0[j];
+        hp1 += coef * sn->sd1[j];
+    }
+    for (j = 0; j < sn->nh; j++) {
+        const hm_real coef = sn->hw[j] * rhs->zh[n][j];
+        hp0 += coef * sn->hd0[j];
+        hp1 += coef * sn->hd1[j];
+    }
+    h[HM_NU] += hp0;
+    h[HM_NU + 1] += hp1;
+}
+
+/* dz of the inequalities of stage n and the soft slack steps, from the (u, x) step of the stage.
+ * Reads each entry of rhs before it writes the same entry of sol, so the two may be one vector. */
+HM_FUNC void ocp_qp_kkt_expand(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_vec *rhs,
+                               hm_ocp_qp_ipm_vec *sol, int n)
+{
+    const hm_real *dux = sol->ux[n];
+    const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
+    int k, j, l;
+    for (k = 0; k < sn->nbp; k++) {
+        const int c = sn->bc[k];
+        for (l = 0; l < 2; l++) sol->zb[n][k][l] = sn->bw[k][l] * (sn->bsg[k][l] * dux[c] - rhs->zb[n][k][l]);
+    }
+    for (j = 0; j < sn->ns; j++) {
+        hm_real gd = -(sn->sd0[j] * dp0 + sn->sd1[j] * dp1);
+        const hm_real dsl = sn->se[j] + sn->swr[j] * sn->shi[j] * gd;
+        sol->s[n][j] = dsl;
+        sol->zs[n][j] = sn->sws[j] * (-dsl - rhs->zs[n][j]);
+        gd -= dsl;
+        sol->zr[n][j] = sn->swr[j] * (gd - rhs->zr[n][j]);
+    }
+    for (j = 0; j < sn->nh; j++) {
+        const hm_real gd = -(sn->hd0[j] * dp0 + sn->hd1[j] * dp1);
+        sol->zh[n][j] = sn->hw[j] * (gd - rhs->zh[n][j]);
+    }
+}
+
+HM_FUNC void ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_vec *rhs,
+                              hm_ocp_qp_ipm_vec *sol)
+{
+    int n, i;
+    for (n = HM_N; n >= 0; n--) {
+        hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        hm_real h[HM_QP_NUX];
+        ocp_qp_kkt_condense(sn, rhs, n, h);
+        if (n < HM_N) {
+            for (i = 0; i < HM_NX; i++) sn->ry[i] = rhs->y[n][i];
+            ocp_qp_kkt_mv4(ws->u.f.st[n + 1].P, sn->ry, sn->Pry);
+        }
+        ocp_qp_kkt_backward_stage(qp, sn, n < HM_N ? &ws->u.f.st[n + 1] : sn, n, h);
+    }
     for (i = 0; i < HM_NX; i++) sol->ux[0][HM_NU + i] = HM_R(0.0);
     for (n = 0; n < HM_N; n++) {
-        const hm_real *restrict Pn = ws->P[n + 1];
-        const hm_real *restrict A = qp->A[n];
-        const hm_real *restrict B = qp->B[n];
-        const hm_real *restrict L = ws->Lr[n];
-        hm_real *ux = sol->ux[n];
-        hm_real *xn = &sol->ux[n + 1][HM_NU];
-        hm_real x[HM_NX], xnew[HM_NX], a0 = ws->yk[n][0], a1 = ws->yk[n][1], u0, u1;
-        for (i = 0; i < HM_NX; i++) x[i] = ux[HM_NU + i];
-        if (n > 0) {
-            const hm_real *restrict Y = ws->Y[n];
-            for (k = 0; k < HM_NX; k++) {
-                a0 += Y[0 + k * HM_NU] * x[k];
-                a1 += Y[1 + k * HM_NU] * x[k];
-            }
+        hm_real u[HM_NU], xn[HM_NX], dy[HM_NX];
+        ocp_qp_kkt_forward_stage(qp, &ws->u.f.st[n], &ws->u.f.st[n + 1], n, &sol->ux[n][HM_NU], u, xn, dy);
+        sol->ux[n][0] = u[0];
+        sol->ux[n][1] = u[1];
+        for (i = 0; i < HM_NX; i++) {
+            sol->ux[n + 1][HM_NU + i] = xn[i];
+            sol->y[n][i] = dy[i];
         }
-        u1 = -a1 * L[2];
-        u0 = -(a0 + L[1] * u1) * L[0];
-        ux[0] = u0;
-        ux[1] = u1;
-        for (i = 0; i < HM_NX; i++) xnew[i] = rhs->y[n][i] + B[i] * u0 + B[i + HM_NX] * u1;
-        if (n > 0) {
-            for (k = 0; k < HM_NX; k++) {
-                const hm_real xk = x[k];
-                for (i = 0; i < HM_NX; i++) xnew[i] += A[i + k * HM_NX] * xk;
-            }
-        }
-        {
-            hm_real dy[HM_NX];
-            for (i = 0; i < HM_NX; i++) dy[i] = ws->p[n + 1][i];
-            for (k = 0; k < HM_NX; k++) {
-                const hm_real xk = xnew[k];
-                for (i = 0; i < HM_NX; i++) dy[i] += Pn[i + k * HM_NX] * xk;
-            }
-            for (i = 0; i < HM_NX; i++) {
-                xn[i] = xnew[i];
-                sol->y[n][i] = -dy[i];
-            }
-        }
-        ocp_qp_kkt_expand(ws, rhs, sol, n);
-        cdot += ocp_qp_kkt_tau_row(ws, sol, n);
+        ocp_qp_kkt_expand(&ws->u.f.st[n], rhs, sol, n);
     }
     for (i = 0; i < HM_NU; i++) sol->ux[HM_N][i] = HM_R(0.0);
-    ocp_qp_kkt_expand(ws, rhs, sol, HM_N);
-    return cdot + ocp_qp_kkt_tau_row(ws, sol, HM_N);
+    ocp_qp_kkt_expand(&ws->u.f.st[HM_N], rhs, sol, HM_N);
 }

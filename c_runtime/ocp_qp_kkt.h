@@ -1,19 +1,27 @@
 /*
  * ocp_qp_kkt.h: the Newton system of the interior-point method, solved by a Riccati recursion.
  *
- * With v = (u_0, x_1, s_1, u_1, ..., x_N, s_N) the primal variables, P the QP Hessian, A_E v = b_E
- * the dynamics, A_I v + t = b_I (t >= 0) the packed inequality rows and w > 0 one weight per row
- * (z / t in the interior-point method), the system is
+ * With v = (u_0, x_1, s_1, u_1, ..., x_N, s_N) the primal variables, P the QP Hessian (times the
+ * cost scale), A_E v = b_E the dynamics (rows x_{n+1} - A_n x_n - B_n u_n), A_I v + t = b_I the
+ * inequalities (t >= 0; the families of hm_types.h: bound sides, soft rows -(D' p + s) + t = -lg,
+ * their s >= 0 as -s + t = 0, hard rows -D' p + t = -lg) and w > 0 one weight per inequality (z / t
+ * in the interior-point method), the system is
  *
  *     [ P    A_E'  A_I'         ] [dv ]   [rhs.ux, rhs.s]
  *     [ A_E  0     0            ] [dy ] = [rhs.y        ]
  *     [ A_I  0     -diag(1 / w) ] [dz ]   [rhs.z        ].
  *
- * dz is eliminated row by row and the soft slacks stage by stage; what is left is an
+ * dz is eliminated inequality by inequality and the soft slacks row by row; what is left is an
  * equality-constrained QP over the stages, solved by a backward Riccati recursion and a forward
- * substitution. Rows enter the (u, x) Hessian of their stage as a diagonal term (bounds) or as a
- * scalar times D D' on the (px, py) block (general rows). The factorisation depends on w only; one
- * factorisation serves any number of right-hand sides.
+ * substitution. Inequalities enter the (u, x) Hessian of their stage as a diagonal term (bounds) or
+ * as a scalar times d d' on the (px, py) block (rows): ws->st[n].Hd and .Hpp. The factorisation
+ * depends on the weights only; one factorisation serves any number of right-hand sides.
+ *
+ * The stage kernels (ocp_qp_kkt_factor_stage, _backward_stage, _forward_stage) are what the
+ * interior-point iteration runs, fused with its own passes (ocp_qp_ipm.c). ocp_qp_kkt_condense_weights,
+ * ocp_qp_kkt_factorize and ocp_qp_kkt_solve are the same system for a general right-hand side in the
+ * layout of ocp_qp_ipm_vec, with the weights taken from the stage blocks (bw, swr, sws, hw): the
+ * tests compare them with a dense solve, and the active-set polish uses them.
  */
 #ifndef OCP_QP_KKT_H
 #define OCP_QP_KKT_H
@@ -21,19 +29,40 @@
 #include "hm_common.h"
 
 #define HM_QP_NUX (HM_NU + HM_NX)
+/* rows per stage rounded up to even: rows are processed in pairs */
+#define HM_QP_NGP ((HM_NG + 1) / 2 * 2)
 
 /* The 2x2 input block and the (px, py) rows are written out for these sizes. */
-typedef char ocp_qp_kkt_sizes_fixed[(HM_NU == 2 && HM_NP == 2 && HM_NG <= 255) ? 1 : -1];
+typedef char ocp_qp_kkt_sizes_fixed[(HM_NU == 2 && HM_NX == 4 && HM_NP == 2 && HM_NG <= 255) ? 1 : -1];
 
-/* Factorise with the row weights ws->w over the row map of ws. 0, or HM_QP_NUMERICAL if a pivot of
- * the reduced input Hessian is not safely positive (the QP is not strictly convex in u along the
- * current active set, or the weights have overflowed). */
+/* Stage n of the factorisation: the stage matrix (cost, sn->Hd, sn->Hpp and, for n < HM_N, the
+ * cost-to-go sn1->P of stage n + 1) and its partial LDL' over the inputs: sn->Ld, sn->Kx and, for
+ * n > 0, the cost-to-go Hessian sn->P. 0, or HM_QP_NUMERICAL if a pivot of the input block is not
+ * safely positive (the QP is not strictly convex in u along the current active set, or the weights
+ * have overflowed). sn1 is unused for n = HM_N. Also sets sn->Pry = sn1->P sn->ry (n < HM_N), the
+ * term of the dynamics' right-hand side that every solve with this factorisation shares. */
+HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *qp, hm_ocp_qp_ipm_stage *sn,
+                                    const hm_ocp_qp_ipm_stage *sn1, int n);
+
+/* Stage n of the backward substitution for the stage gradient h (6 entries, of the condensed QP):
+ * sn->yk and, for n > 0, sn->p, from sn1->p (and sn->Pry). */
+HM_FUNC void ocp_qp_kkt_backward_stage(const hm_ocp_qp *qp, hm_ocp_qp_ipm_stage *sn,
+                                       const hm_ocp_qp_ipm_stage *sn1, int n, const hm_real *h);
+
+/* Stage n < HM_N of the forward substitution: from the state step x (zero for n = 0) the input
+ * step u, the next state step xn = A x + B u + sn->ry and the multiplier step dy of the dynamics. */
+HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_stage *sn,
+                                      const hm_ocp_qp_ipm_stage *sn1, int n, const hm_real *x, hm_real *u,
+                                      hm_real *xn, hm_real *dy);
+
+/* General system. ocp_qp_kkt_condense_weights: sn->Hd, sn->Hpp and the soft rows' 1 / (Zl + wr + ws)
+ * from the weights in the stage blocks. ocp_qp_kkt_factorize: all stages. 0 or HM_QP_NUMERICAL. */
+HM_FUNC void ocp_qp_kkt_condense_weights(hm_ocp_qp_ipm_ws *ws);
 HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws);
 
-/* Solve with the last factorisation; sol may be rhs (solved in place). Returns c' sol_v + b' sol_w
- * for the vectors c = (ws->c_ux, ws->c_s) and b = (ws->b_eq, ws->b_ineq) of the interior-point method
- * (the tau row of its Newton system), accumulated stage by stage during the forward pass. */
-HM_FUNC hm_real ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_vec *rhs,
-                                 hm_ocp_qp_ipm_vec *sol);
+/* Solve with the last factorisation (of ocp_qp_kkt_factorize); sol may be rhs. Uses the stage
+ * blocks' ry, p, yk as scratch. */
+HM_FUNC void ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_vec *rhs,
+                              hm_ocp_qp_ipm_vec *sol);
 
 #endif /* OCP_QP_KKT_H */

@@ -100,6 +100,7 @@ class Result:
     res: dict[str, float]  # ocp_qp_res recorded in the workspace
     scaled: tuple[float, float, float]  # res_primal, res_dual, gap
     mu_tau_kappa: tuple[float, float, float]
+    fallback: int = 0  # the homogeneous-embedding fallback solver produced the result
 
 
 def present(v: Array | float) -> Any:
@@ -243,8 +244,9 @@ class Harness:
                                       self.ffi.from_buffer("double[]", scaled), self.ffi.from_buffer("double[]", mtk))
         assert st == status
         res = {k: float(v) for k, v in zip(RES_KEYS, res6, strict=True)}
-        return Result(status, int(it[0]), int(polls[0]), int(flags[0]) & 1, int(flags[0]) >> 1, self.sol(), res,
-                      (scaled[0], scaled[1], scaled[2]), (mtk[0], mtk[1], mtk[2]))
+        f = int(flags[0])
+        return Result(status, int(it[0]), int(polls[0]), f & 1, (f >> 1) & 1, self.sol(), res,
+                      (scaled[0], scaled[1], scaled[2]), (mtk[0], mtk[1], mtk[2]), (f >> 2) & 1)
 
     def res_compute(self) -> dict[str, float]:
         """ocp_qp_res_compute on the loaded problem and the current (possibly edited) solution."""

@@ -2,7 +2,12 @@
  * qp_bench.c: time of the QP solver on QPs shaped like the navigation MPC's.
  *
  *     cc -O2 -Ic_runtime -DQPB_N=50 -DQPB_NG=6 tests/c/qp_bench.c -o qp_bench -lm
- *     ./qp_bench [repetitions [polish [tol]]]      (prints one line per case)
+ *     ./qp_bench [repetitions [polish [tol [qp_file]]]]      (prints one line per case)
+ *
+ * With qp_file (raw ocp_qp structs of these sizes, one after the other, e.g. dumped from a generated
+ * solver after each RTI step), every QP of the file is solved repetitions times instead, and the
+ * distribution over the file of the per-QP median solve time is printed (median, p90, p99, max),
+ * with the iteration counts and statuses.
  *
  * The QPs linearise the unicycle (RK4 with dt = T / N) around a curved reference trajectory, with
  * the paper's weights (goal, terminal, a small Levenberg-Marquardt term), bounds on v, a and omega,
@@ -152,6 +157,53 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+#define QPB_FILE_MAX 4096
+static double g_med[QPB_FILE_MAX], g_per_iter[QPB_FILE_MAX];
+static int g_iters[QPB_FILE_MAX];
+
+static int bench_file(const char *path, int reps, const hm_ocp_qp_ipm_arg *arg)
+{
+    static double times[1000];
+    FILE *f = fopen(path, "rb");
+    int count = 0, k, status_count[6] = {0, 0, 0, 0, 0, 0}, it_hist[64] = {0}, it_sum = 0, fallbacks = 0;
+    if (!f) {
+        printf("cannot open %s\n", path);
+        return 1;
+    }
+    while (count < QPB_FILE_MAX && fread(&g_qp, sizeof g_qp, 1, f) == 1) {
+        int r, status = 0;
+        for (r = 0; r < reps && r < 1000; r++) {
+            const double t0 = now_s();
+            status = ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, arg);
+            times[r] = now_s() - t0;
+        }
+        qsort(times, (size_t)r, sizeof times[0], cmp_double);
+        g_med[count] = times[r / 2];
+        g_iters[count] = g_ws.iter;
+        g_per_iter[count] = times[r / 2] / (g_ws.iter > 0 ? g_ws.iter : 1);
+        it_sum += g_ws.iter;
+        fallbacks += g_ws.fallback;
+        it_hist[g_ws.iter < 63 ? g_ws.iter : 63]++;
+        if (status >= 0 && status < 6) status_count[status]++;
+        count++;
+    }
+    fclose(f);
+    if (count == 0) return 1;
+    qsort(g_med, (size_t)count, sizeof g_med[0], cmp_double);
+    qsort(g_per_iter, (size_t)count, sizeof g_per_iter[0], cmp_double);
+    printf("N=%d NG=%d file %s: %d QPs, solve median %.2f p90 %.2f p99 %.2f max %.2f us; per iteration median %.2f us;"
+           " iterations mean %.2f; status solved %d max_iter %d infeasible %d numerical %d; fallbacks %d\n",
+           HM_N, HM_NG, path, count, 1e6 * g_med[count / 2], 1e6 * g_med[(count * 9) / 10],
+           1e6 * g_med[(count * 99) / 100], 1e6 * g_med[count - 1], 1e6 * g_per_iter[count / 2],
+           (double)it_sum / count, status_count[0], status_count[1], status_count[2], status_count[3], fallbacks);
+    printf("iterations:");
+    for (k = 0; k < 64; k++) {
+        if (it_hist[k]) printf(" %d:%d", k, it_hist[k]);
+    }
+    printf("\n");
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const int reps = argc > 1 ? atoi(argv[1]) : 2000;
@@ -161,6 +213,7 @@ int main(int argc, char **argv)
     ocp_qp_ipm_arg_set_default(&arg);
     if (argc > 2) arg.polish = atoi(argv[2]);
     if (argc > 3) arg.tol = (hm_real)atof(argv[3]);
+    if (argc > 4) return bench_file(argv[4], reps, &arg);
     for (c = 0; c < 4; c++) {
         int r, status = 0, iters = 0;
         double med, mn;

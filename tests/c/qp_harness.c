@@ -47,22 +47,25 @@ static hm_ocp_qp_ipm_vec g_vec;
 static int g_stop_after = -1;
 static int g_polls;
 
+/* Inequalities of the whole QP at most: per stage both sides of 6 components, and soft rows (2). */
+#define QPT_NC_MAX ((HM_N + 1) * (2 * HM_QP_NUX + 2 * HM_NG))
+
 int qp_harness_dims(int *n, int *ng, int *real_size, int *nc_max)
 {
     *n = HM_N;
     *ng = HM_NG;
     *real_size = (int)sizeof(hm_real);
-    *nc_max = HM_QP_NC_MAX;
+    *nc_max = QPT_NC_MAX;
     return 0;
 }
 
-/* 0: ocp_qp, 1: ocp_qp_sol, 2: ocp_qp_ipm_vec, 3: ocp_qp_ipm_ws */
+/* 0: ocp_qp, 1: ocp_qp_sol, 2: the flat vector of qp_harness_kkt_solve, 3: ocp_qp_ipm_ws */
 size_t qp_harness_sizeof(int which)
 {
     switch (which) {
     case 0: return sizeof(hm_ocp_qp);
     case 1: return sizeof(hm_ocp_qp_sol);
-    case 2: return sizeof(hm_ocp_qp_ipm_vec);
+    case 2: return sizeof(hm_real) * (size_t)((HM_N + 1) * HM_QP_NUX + (HM_N + 1) * HM_NG + HM_N * HM_NX + QPT_NC_MAX);
     default: return sizeof(hm_ocp_qp_ipm_ws);
     }
 }
@@ -127,19 +130,20 @@ static void qp_harness_copy_res(const hm_ocp_qp_res *res, double *res6)
     res6[5] = (double)res->obj;
 }
 
-/* Report of the last solve; flags: 1 unbounded, 2 polished. Returns its status. */
+/* Report of the last solve; flags: 1 unbounded, 2 polished, 4 solved by the fallback. Returns its
+ * status. */
 int qp_harness_info(int *iter, int *polls, int *flags, double *res6, double *scaled3, double *mtk3)
 {
     *iter = g_ws.iter;
     *polls = g_polls;
-    *flags = g_ws.unbounded + 2 * g_ws.polished;
+    *flags = g_ws.unbounded + 2 * g_ws.polished + 4 * g_ws.fallback;
     qp_harness_copy_res(&g_ws.res, res6);
     scaled3[0] = (double)g_ws.res_primal;
     scaled3[1] = (double)g_ws.res_dual;
     scaled3[2] = (double)g_ws.gap;
     mtk3[0] = (double)g_ws.mu;
-    mtk3[1] = (double)g_ws.tau;
-    mtk3[2] = (double)g_ws.kappa;
+    mtk3[1] = 1.0; /* tau and kappa of the homogeneous embedding the solver no longer uses */
+    mtk3[2] = 0.0;
     return g_ws.status;
 }
 
@@ -156,35 +160,125 @@ const char *qp_harness_status_message(int status)
     return ocp_qp_status_message(status);
 }
 
-/* Builds the packed row map of the current problem; arrays have HM_N + 1 entries. Also reports the
- * cost scale the Newton system is built with. Returns the setup status (HM_QP_INFEASIBLE for
- * crossing bounds). */
+/* The packed order of the inequalities of stage n (the order of tests/qp_harness.py's conic form):
+ * present bound sides (u before x, lower before upper), present general rows in QP order, then the
+ * s >= 0 rows of the soft ones. For each packed general row k of stage n, *is_soft and the index in
+ * its family. */
+static void qp_harness_row_map(int n, int *kind, int *fam)
+{
+    const hm_ocp_qp_ipm_stage *sn = &g_ws.u.f.st[n];
+    int i, js = 0, jh = 0, k = 0;
+    for (i = 0; i < g_qp.ng[n] && n > 0; i++) {
+        if (!ocp_qp_bound_present(g_qp.lg[n][i])) continue;
+        if (js < sn->ns && sn->srow[js] == i) {
+            kind[k] = 1;
+            fam[k] = js++;
+        } else {
+            kind[k] = 0;
+            fam[k] = jh++;
+        }
+        k++;
+    }
+}
+
+/* Builds the row map of the current problem; arrays have HM_N + 1 entries (packed offsets and
+ * counts: bound sides, general rows, soft rows). Also reports the cost scale the Newton system is
+ * built with. Returns the setup status (HM_QP_INFEASIBLE for crossing bounds). */
 int qp_harness_kkt_map(int *m, int *off, int *nb, int *nr, int *ns, double *cost_scale)
 {
-    int bad = 0, n;
+    int bad = 0, n, k, total = 0;
     const int status = ocp_qp_ipm_setup(&g_qp, &g_ws, &bad);
-    *m = g_ws.m;
-    *cost_scale = (double)g_ws.cost_scale;
+    if (status) return status;
     for (n = 0; n <= HM_N; n++) {
-        off[n] = g_ws.off[n];
-        nb[n] = g_ws.nb[n];
-        nr[n] = g_ws.nr[n];
-        ns[n] = g_ws.ns[n];
+        const hm_ocp_qp_ipm_stage *sn = &g_ws.u.f.st[n];
+        int cnt = 0;
+        for (k = 0; k < sn->nbp; k++) cnt += (sn->bsg[k][0] != 0) + (sn->bsg[k][1] != 0);
+        off[n] = total;
+        nb[n] = cnt;
+        nr[n] = sn->ns + sn->nh;
+        ns[n] = sn->ns;
+        total += cnt + sn->ns + sn->nh + sn->ns;
     }
+    *m = total;
+    *cost_scale = (double)g_ws.cost_scale;
     return status;
 }
 
-/* Solves the Newton system of ocp_qp_kkt.h with row weights w[0..m-1] for the right-hand side rhs
- * (an ocp_qp_ipm_vec as a flat array) into sol (the same layout). Returns the factorisation status. */
+/* Solves the Newton system of ocp_qp_kkt.h with weights w[0..m-1] (packed order) for the right-hand
+ * side rhs into sol, both flat arrays of the layout (ux[HM_N+1][6], s[HM_N+1][HM_NG] by packed
+ * general row, y[HM_N][4], z[m] packed). Returns the factorisation status. */
 int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
 {
-    int bad = 0, j, status;
+    const int off_s = (HM_N + 1) * HM_QP_NUX;
+    const int off_y = off_s + (HM_N + 1) * HM_NG;
+    const int off_z = off_y + HM_N * HM_NX;
+    int bad = 0, n, i, k, l, j, status, pos = 0;
+    int kind[HM_NG], fam[HM_NG];
+    hm_ocp_qp_ipm_vec *v = &g_vec;
     if (ocp_qp_ipm_setup(&g_qp, &g_ws, &bad)) return HM_QP_INFEASIBLE;
-    for (j = 0; j < g_ws.m; j++) g_ws.w[j] = w[j];
+    memset(v, 0, sizeof *v);
+    for (n = 0; n <= HM_N; n++) {
+        hm_ocp_qp_ipm_stage *sn = &g_ws.u.f.st[n];
+        for (i = 0; i < HM_QP_NUX; i++) v->ux[n][i] = rhs[n * HM_QP_NUX + i];
+        if (n < HM_N) {
+            for (i = 0; i < HM_NX; i++) v->y[n][i] = rhs[off_y + n * HM_NX + i];
+        }
+        for (k = 0; k < sn->nbp; k++) {
+            for (l = 0; l < 2; l++) {
+                sn->bw[k][l] = HM_R(1.0);
+                if (sn->bsg[k][l] == 0) continue;
+                sn->bw[k][l] = w[pos];
+                v->zb[n][k][l] = rhs[off_z + pos];
+                pos++;
+            }
+        }
+        qp_harness_row_map(n, kind, fam);
+        for (k = 0; k < sn->ns + sn->nh; k++) {
+            if (kind[k]) {
+                sn->swr[fam[k]] = w[pos];
+                v->zr[n][fam[k]] = rhs[off_z + pos];
+                v->s[n][fam[k]] = rhs[off_s + n * HM_NG + k];
+            } else {
+                sn->hw[fam[k]] = w[pos];
+                v->zh[n][fam[k]] = rhs[off_z + pos];
+            }
+            pos++;
+        }
+        for (j = 0; j < sn->ns; j++) {
+            sn->sws[j] = w[pos];
+            v->zs[n][j] = rhs[off_z + pos];
+            pos++;
+        }
+    }
+    ocp_qp_kkt_condense_weights(&g_ws);
     status = ocp_qp_kkt_factorize(&g_qp, &g_ws);
     if (status) return status;
-    memcpy(&g_vec, rhs, sizeof g_vec);
-    ocp_qp_kkt_solve(&g_qp, &g_ws, &g_vec, &g_vec);
-    memcpy(sol, &g_vec, sizeof g_vec);
+    ocp_qp_kkt_solve(&g_qp, &g_ws, v, v);
+    pos = 0;
+    for (i = 0; i < off_z; i++) sol[i] = 0;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_ocp_qp_ipm_stage *sn = &g_ws.u.f.st[n];
+        for (i = 0; i < HM_QP_NUX; i++) sol[n * HM_QP_NUX + i] = v->ux[n][i];
+        if (n < HM_N) {
+            for (i = 0; i < HM_NX; i++) sol[off_y + n * HM_NX + i] = v->y[n][i];
+        }
+        for (k = 0; k < sn->nbp; k++) {
+            for (l = 0; l < 2; l++) {
+                if (sn->bsg[k][l] == 0) continue;
+                sol[off_z + pos++] = v->zb[n][k][l];
+            }
+        }
+        qp_harness_row_map(n, kind, fam);
+        for (k = 0; k < sn->ns + sn->nh; k++) {
+            if (kind[k]) {
+                sol[off_z + pos] = v->zr[n][fam[k]];
+                sol[off_s + n * HM_NG + k] = v->s[n][fam[k]];
+            } else {
+                sol[off_z + pos] = v->zh[n][fam[k]];
+            }
+            pos++;
+        }
+        for (j = 0; j < sn->ns; j++) sol[off_z + pos++] = v->zs[n][j];
+    }
     return 0;
 }
