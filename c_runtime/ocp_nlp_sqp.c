@@ -50,6 +50,7 @@ HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
         for (i = 0; i < HM_NX; i++) s->x[n][i] = HM_R(0.0);
     s->cost = HM_R(0.0);
     s->time_prepare_ms = HM_R(0.0);
+    s->screen_radius[0] = HM_INF;
 }
 
 /* x_{n+1} = F(x_n, u_n) for n = 0..N-1 from the given x_0. */
@@ -76,6 +77,7 @@ static void ocp_nlp_shift(hm_solver *s, const hm_input *in)
         for (i = 0; i < HM_NX; i++) s->x[0][i] = in->x0[i];
         for (n = 0; n < HM_N; n++)
             for (i = 0; i < HM_NU; i++) s->u[n][i] = HM_R(0.0);
+        s->screen_radius[0] = HM_INF; /* no previous step to size the screening by */
     } else {
         hm_ocp_qp_sol *m = &s->mult;
         for (i = 0; i < HM_NX; i++) s->x[0][i] = s->x[1][i];
@@ -108,6 +110,7 @@ static void ocp_nlp_init_braking(hm_solver *s, const hm_input *in)
         hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], A, B);
     }
     ocp_qp_sol_set_zero(&s->mult);
+    s->screen_radius[0] = HM_INF;
 }
 
 static hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2)
@@ -317,21 +320,161 @@ HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in)
     s->time_prepare_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
 }
 
-/* Solve the QP of the current linearisation (its x0 offset set). Returns the QP status. */
-static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int *qp_iter)
-{
-    int status;
-    s->ipm_arg.max_iter = s->params.qp_max_iter;
-    s->ipm_arg.tol = tol;
-    status = ocp_qp_ipm_solve(&s->qp, &s->qp_sol, &s->ipm_ws, &s->ipm_arg);
-    *qp_iter += s->ipm_ws.iter;
-    return status;
-}
+/* ------------------------------------------------------------------------------------------------
+ * Row screening
+ *
+ * Most distance rows of a crowd are far from binding: a human 3 m from the planned node cannot
+ * constrain a step that moves the node by centimetres. Such rows are left out of the QP, and the
+ * QP's solution is checked against every one of them afterwards. If it satisfies them all, it is
+ * the solution of the whole QP (the QP is convex and its feasible set a subset of the screened
+ * one's; a soft row satisfied at s = 0 adds nothing to the objective), with multipliers zero on
+ * the rows left out and the slack bound's multiplier equal to the L1 weight. Rows found violated
+ * join the QP, which is solved again: the outcome is exact whatever the screening radius, which
+ * only decides the cost. The radius of a stage follows the last QP step there: SCREEN_MIN plus
+ * twice the larger displacement of the two nodes that the shift brings to it (RTI steps move the
+ * far end of the plan by metres and the near end by centimetres). Without a previous step (cold
+ * start, braking retry; screen_radius[0] = HM_INF) nothing is screened.
+ * ---------------------------------------------------------------------------------------------- */
 
 static int ocp_nlp_qp_usable(int status)
 {
     return status == HM_QP_SOLVED || status == HM_QP_MAX_ITER;
 }
+
+#define OCP_NLP_SCREEN_MIN HM_R(0.5)   /* smallest screening radius [m] */
+#define OCP_NLP_SCREEN_ROUNDS 3        /* re-solves with violated rows before all rows go in */
+
+static void ocp_nlp_swap_rows(hm_solver *s, int n, int a, int b)
+{
+    hm_ocp_qp *qp = &s->qp;
+    hm_real t;
+    int ti;
+    unsigned char tp;
+    if (a == b) return;
+    t = qp->D[n][a][0]; qp->D[n][a][0] = qp->D[n][b][0]; qp->D[n][b][0] = t;
+    t = qp->D[n][a][1]; qp->D[n][a][1] = qp->D[n][b][1]; qp->D[n][b][1] = t;
+    t = qp->lg[n][a]; qp->lg[n][a] = qp->lg[n][b]; qp->lg[n][b] = t;
+    t = qp->zl[n][a]; qp->zl[n][a] = qp->zl[n][b]; qp->zl[n][b] = t;
+    t = qp->Zl[n][a]; qp->Zl[n][a] = qp->Zl[n][b]; qp->Zl[n][b] = t;
+    ti = qp->soft[n][a]; qp->soft[n][a] = qp->soft[n][b]; qp->soft[n][b] = ti;
+    tp = s->row_perm[n][a]; s->row_perm[n][a] = s->row_perm[n][b]; s->row_perm[n][b] = tp;
+}
+
+/* Rows with margin -lg = d - d_min below the stage's radius first; qp.ng[n] counts them. */
+static void ocp_nlp_screen_rows(hm_solver *s)
+{
+    hm_ocp_qp *qp = &s->qp;
+    int n, j;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_real radius = s->screen_radius[n];
+        int kept = 0;
+        s->ng_full[n] = qp->ng[n];
+        for (j = 0; j < qp->ng[n]; j++) s->row_perm[n][j] = (unsigned char)j;
+        for (j = 0; j < qp->ng[n]; j++) {
+            if (-qp->lg[n][j] < radius) ocp_nlp_swap_rows(s, n, j, kept++);
+        }
+        qp->ng[n] = kept;
+    }
+}
+
+/* Rows left out that the QP's step violates (by more than tol) join the QP; returns how many. */
+static int ocp_nlp_admit_violated_rows(hm_solver *s, hm_real tol)
+{
+    hm_ocp_qp *qp = &s->qp;
+    int n, j, added = 0;
+    for (n = 1; n <= HM_N; n++) {
+        const hm_real dp0 = s->qp_sol.x[n][0], dp1 = s->qp_sol.x[n][1];
+        for (j = qp->ng[n]; j < s->ng_full[n]; j++) {
+            const hm_real lg = qp->lg[n][j];
+            if (qp->D[n][j][0] * dp0 + qp->D[n][j][1] * dp1 < lg - tol * hm_fmax(HM_R(1.0), hm_fabs(lg))) {
+                ocp_nlp_swap_rows(s, n, j, qp->ng[n]++);
+                added++;
+            }
+        }
+    }
+    return added;
+}
+
+/* All rows back in their order; the rows left out get their exact multipliers (zero; the slack
+ * bound's the L1 weight) and slack (zero). */
+static void ocp_nlp_unscreen_rows(hm_solver *s)
+{
+    hm_ocp_qp *qp = &s->qp;
+    hm_ocp_qp_sol *sol = &s->qp_sol;
+    hm_real D[HM_NG][HM_NP], lg[HM_NG], zl[HM_NG], Zl[HM_NG], sl[HM_NG], lam[HM_NG], lam_s[HM_NG];
+    int soft[HM_NG];
+    int n, j;
+    for (n = 0; n <= HM_N; n++) {
+        const int full = s->ng_full[n];
+        for (j = qp->ng[n]; j < full; j++) {
+            sol->s[n][j] = HM_R(0.0);
+            sol->lam_lg[n][j] = HM_R(0.0);
+            sol->lam_ls[n][j] = qp->soft[n][j] ? qp->zl[n][j] : HM_R(0.0);
+        }
+        for (j = 0; j < full; j++) {
+            const int r = s->row_perm[n][j];
+            D[r][0] = qp->D[n][j][0];
+            D[r][1] = qp->D[n][j][1];
+            lg[r] = qp->lg[n][j];
+            zl[r] = qp->zl[n][j];
+            Zl[r] = qp->Zl[n][j];
+            soft[r] = qp->soft[n][j];
+            sl[r] = sol->s[n][j];
+            lam[r] = sol->lam_lg[n][j];
+            lam_s[r] = sol->lam_ls[n][j];
+        }
+        for (j = 0; j < full; j++) {
+            qp->D[n][j][0] = D[j][0];
+            qp->D[n][j][1] = D[j][1];
+            qp->lg[n][j] = lg[j];
+            qp->zl[n][j] = zl[j];
+            qp->Zl[n][j] = Zl[j];
+            qp->soft[n][j] = soft[j];
+            sol->s[n][j] = sl[j];
+            sol->lam_lg[n][j] = lam[j];
+            sol->lam_ls[n][j] = lam_s[j];
+        }
+        qp->ng[n] = full;
+    }
+}
+
+/* Screening radii of the next QP from the displacements of this QP's step (see above). */
+static void ocp_nlp_size_screening(hm_solver *s)
+{
+    hm_real d2[HM_N + 2];
+    int n;
+    for (n = 0; n <= HM_N; n++) d2[n] = s->qp_sol.x[n][0] * s->qp_sol.x[n][0] + s->qp_sol.x[n][1] * s->qp_sol.x[n][1];
+    d2[HM_N + 1] = d2[HM_N];
+    for (n = 0; n <= HM_N; n++)
+        s->screen_radius[n] = OCP_NLP_SCREEN_MIN + HM_R(2.0) * hm_sqrt(hm_fmax(d2[n], d2[n + 1]));
+}
+
+/* Solve the QP of the current linearisation (its x0 offset set), screened. Returns the QP status. */
+static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int *qp_iter)
+{
+    const int screen = s->params.row_screening && s->screen_radius[0] < HM_INF;
+    int status, round;
+    s->ipm_arg.max_iter = s->params.qp_max_iter;
+    s->ipm_arg.tol = tol;
+    if (screen) ocp_nlp_screen_rows(s);
+    for (round = 0;; round++) {
+        status = ocp_qp_ipm_solve(&s->qp, &s->qp_sol, &s->ipm_ws, &s->ipm_arg);
+        *qp_iter += s->ipm_ws.iter;
+        s->qp_solves++;
+        if (!screen || !ocp_nlp_qp_usable(status)) break;
+        if (round == OCP_NLP_SCREEN_ROUNDS) {
+            /* pathological: rows keep turning up; the whole QP settles it */
+            int n;
+            for (n = 0; n <= HM_N; n++) s->qp.ng[n] = s->ng_full[n];
+            continue;
+        }
+        if (round > OCP_NLP_SCREEN_ROUNDS || ocp_nlp_admit_violated_rows(s, tol) == 0) break;
+    }
+    if (screen) ocp_nlp_unscreen_rows(s);
+    if (ocp_nlp_qp_usable(status)) ocp_nlp_size_screening(s);
+    return status;
+}
+
 
 /* Iterate = base + alpha * QP step (base: the linearisation point, kept in x_base/u_base). */
 static void ocp_nlp_step_from_base(hm_solver *s, hm_real alpha)
@@ -608,6 +751,7 @@ static void ocp_nlp_clear_output(hm_output *out)
     out->qp_status = -1;
     out->qp_iterations = 0;
     out->sqp_iterations = 0;
+    out->qp_solves = 0;
     out->cost = HM_R(0.0);
     out->kkt_stat = HM_R(0.0);
     out->kkt_eq = HM_R(0.0);
@@ -660,6 +804,7 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
     int qp_status, status, reason;
     ocp_nlp_start_clock(s, t_start);
     ocp_nlp_clear_output(out);
+    s->qp_solves = 0;
     out->sqp_iterations = 1;
     reason = ocp_nlp_check_before(s, in);
     if (reason == HM_STOP_NONE) {
@@ -724,6 +869,7 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
     } else {
         ocp_nlp_protective_stop(s, in, out, reason);
     }
+    out->qp_solves = s->qp_solves;
     out->time_prepare_ms = s->time_prepare_ms;
     out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t_feedback);
     out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t_start);
@@ -750,6 +896,7 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
     const unsigned long long t0 = ocp_nlp_now(s);
     int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER, reason;
     ocp_nlp_clear_output(out);
+    s->qp_solves = 0;
     reason = ocp_nlp_check_before(s, in);
     if (reason != HM_STOP_NONE) {
         ocp_nlp_protective_stop(s, in, out, reason);
@@ -789,6 +936,7 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
     out->status = status;
     out->qp_status = qp_status;
     out->sqp_iterations = k;
+    out->qp_solves = s->qp_solves;
     reason = HM_STOP_NONE;
     if (status == HM_STATUS_QP_FAILED) {
         reason = HM_STOP_QP_FAILED;

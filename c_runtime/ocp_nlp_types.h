@@ -17,6 +17,13 @@ typedef struct HM_NS(solver) {
     int warm;        /* 1: x, u, mult hold a previous solution to shift */
     int prepared;    /* 1: qp holds the linearisation for the next feedback */
     int n_active;    /* humans and obstacle rows of the current linearisation */
+    /* Row screening (ocp_nlp_sqp.c): rows of stage n whose linearised margin exceeds screen_radius[n]
+     * are left out of the QP (ng_full[n] rows built, qp.ng[n] passed), in the order row_perm, and
+     * checked after. */
+    HM_REAL screen_radius[HM_N + 1];
+    int qp_solves;   /* QPs solved in the current step */
+    int ng_full[HM_N + 1];
+    unsigned char row_perm[HM_N + 1][HM_NG];
     /* The QP of the current linearisation and its solver. */
     HM_NS(ocp_qp) qp;
     HM_NS(ocp_qp_sol) qp_sol;

@@ -243,6 +243,10 @@ class Solver:
     line_search: bool = boolean(
         False, "RTI: damp the QP step by a backtracking line search on the l1 merit (false: full step)"
     )
+    row_screening: bool = boolean(
+        True, "leave distance rows far from binding out of each QP and check them at its solution (re-solving "
+        "with any that are violated): the same solution, at the cost of the rows that matter"
+    )
 
 
 @dataclass(frozen=True)

@@ -49,6 +49,7 @@ class StepResult:
     qp_status: int
     qp_iterations: int
     sqp_iterations: int
+    qp_solves: int  # QPs solved in the step (row screening re-solves, the braking retry)
     cost: float
     kkt_stat: float
     kkt_eq: float
@@ -180,7 +181,7 @@ class Solver:
             u0=self._out_u0.astype(np.float64), command=self._out_cmd.astype(np.float64),
             x=self._out_x.astype(np.float64), u=self._out_u.astype(np.float64),
             status=o.status, qp_status=o.qp_status, qp_iterations=o.qp_iterations,
-            sqp_iterations=o.sqp_iterations, cost=o.cost, kkt_stat=o.kkt_stat, kkt_eq=o.kkt_eq,
+            sqp_iterations=o.sqp_iterations, qp_solves=o.qp_solves, cost=o.cost, kkt_stat=o.kkt_stat, kkt_eq=o.kkt_eq,
             kkt_ineq=o.kkt_ineq, kkt_comp=o.kkt_comp, min_human_distance=o.min_human_distance,
             time_prepare_ms=o.time_prepare_ms, time_feedback_ms=o.time_feedback_ms,
             time_total_ms=o.time_total_ms,
@@ -258,9 +259,9 @@ class Solver:
                     raise ValueError(f"qp_max_iter must be an integer in [1, 1000], got {value!r}")
                 staged.append((key, value))
                 continue
-            if key == "line_search":
+            if key in ("line_search", "row_screening"):
                 if not isinstance(value, bool) and value not in (0, 1):
-                    raise ValueError(f"line_search must be true or false, got {value!r}")
+                    raise ValueError(f"{key} must be true or false, got {value!r}")
                 staged.append((key, int(value)))
                 continue
             arr = np.asarray(value, dtype=np.float64)
