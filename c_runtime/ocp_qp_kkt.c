@@ -51,7 +51,7 @@ HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_
 {
     hm_real Hxx[HM_NX * HM_NX], Hxu[HM_NX * HM_NU];   /* column-major; Hxu column j for u_j */
     hm_real h00 = HM_R(0.0), h10 = HM_R(0.0), h11 = HM_R(0.0);
-    int i, j, k;
+    int i, j;
 
     if (n < HM_N) {
         const hm_real *restrict P = sn1->P;
@@ -65,16 +65,37 @@ HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_
         h11 = sn->R[3] + sn->Hd[1] + ocp_qp_kkt_dot4(B + HM_NX, FB + HM_NX);
         if (n > 0) {
             hm_real FA[HM_NX * HM_NX];   /* P_{n+1} A */
-            ocp_qp_kkt_mul4(P, A, FA, HM_NX);
-            /* A' F as sum over k of (row k of A)' times row k of F, column by column */
-            for (j = 0; j < HM_NU; j++) {
-                for (i = 0; i < HM_NX; i++) Hxu[i + j * HM_NX] = sn->S[j + i * HM_NU] + ocp_qp_kkt_dot4(A + i * HM_NX, FB + j * HM_NX);
-            }
-            for (j = 0; j < HM_NX; j++) {
-                for (i = 0; i < HM_NX; i++) {
-                    hm_real acc = sn->Q[i + j * HM_NX];
-                    for (k = 0; k < HM_NX; k++) acc += A[k + i * HM_NX] * FA[k + j * HM_NX];
-                    Hxx[i + j * HM_NX] = acc;
+            if (sn->a_id) {
+                /* A = [e_0 e_1 a_2 a_3] (the position does not enter the dynamics of the others):
+                 * P A = [P e_0, P e_1, P a_2, P a_3], and A' F reads rows 0 and 1 of F directly */
+                for (i = 0; i < 2 * HM_NX; i++) FA[i] = P[i];
+                ocp_qp_kkt_mul4(P, A + 2 * HM_NX, FA + 2 * HM_NX, 2);
+                for (j = 0; j < HM_NU; j++) {
+                    const hm_real *restrict f = FB + j * HM_NX;
+                    Hxu[0 + j * HM_NX] = sn->S[j + 0 * HM_NU] + f[0];
+                    Hxu[1 + j * HM_NX] = sn->S[j + 1 * HM_NU] + f[1];
+                    Hxu[2 + j * HM_NX] = sn->S[j + 2 * HM_NU] + ocp_qp_kkt_dot4(A + 2 * HM_NX, f);
+                    Hxu[3 + j * HM_NX] = sn->S[j + 3 * HM_NU] + ocp_qp_kkt_dot4(A + 3 * HM_NX, f);
+                }
+                /* lower triangle; (i, j) for i in {0, 1} is F[i, j], for i in {2, 3} a_i' F_j */
+                for (j = 0; j < 2; j++) {
+                    for (i = j; i < 2; i++) Hxx[i + j * HM_NX] = sn->Q[i + j * HM_NX] + FA[i + j * HM_NX];
+                    /* a_i' P e_j = (P a_i)_j */
+                    Hxx[2 + j * HM_NX] = sn->Q[2 + j * HM_NX] + FA[j + 2 * HM_NX];
+                    Hxx[3 + j * HM_NX] = sn->Q[3 + j * HM_NX] + FA[j + 3 * HM_NX];
+                }
+                Hxx[2 + 2 * HM_NX] = sn->Q[2 + 2 * HM_NX] + ocp_qp_kkt_dot4(A + 2 * HM_NX, FA + 2 * HM_NX);
+                Hxx[3 + 2 * HM_NX] = sn->Q[3 + 2 * HM_NX] + ocp_qp_kkt_dot4(A + 3 * HM_NX, FA + 2 * HM_NX);
+                Hxx[3 + 3 * HM_NX] = sn->Q[3 + 3 * HM_NX] + ocp_qp_kkt_dot4(A + 3 * HM_NX, FA + 3 * HM_NX);
+            } else {
+                ocp_qp_kkt_mul4(P, A, FA, HM_NX);
+                for (j = 0; j < HM_NU; j++) {
+                    for (i = 0; i < HM_NX; i++)
+                        Hxu[i + j * HM_NX] = sn->S[j + i * HM_NU] + ocp_qp_kkt_dot4(A + i * HM_NX, FB + j * HM_NX);
+                }
+                for (j = 0; j < HM_NX; j++) {
+                    for (i = j; i < HM_NX; i++)
+                        Hxx[i + j * HM_NX] = sn->Q[i + j * HM_NX] + ocp_qp_kkt_dot4(A + i * HM_NX, FA + j * HM_NX);
                 }
             }
         }
@@ -155,8 +176,15 @@ HM_FUNC void ocp_qp_kkt_backward_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_i
             const hm_real c0 = y0 * L[0], c1 = y1 * L[2];
             const hm_real *restrict K0 = sn->Kx;
             const hm_real *restrict K1 = sn->Kx + HM_NX;
-            for (i = 0; i < HM_NX; i++)
-                sn->p[i] = h[HM_NU + i] + ocp_qp_kkt_dot4(A + i * HM_NX, pb) - K0[i] * c0 - K1[i] * c1;
+            if (sn->a_id) {
+                sn->p[0] = h[HM_NU] + pb[0] - K0[0] * c0 - K1[0] * c1;
+                sn->p[1] = h[HM_NU + 1] + pb[1] - K0[1] * c0 - K1[1] * c1;
+                for (i = 2; i < HM_NX; i++)
+                    sn->p[i] = h[HM_NU + i] + ocp_qp_kkt_dot4(A + i * HM_NX, pb) - K0[i] * c0 - K1[i] * c1;
+            } else {
+                for (i = 0; i < HM_NX; i++)
+                    sn->p[i] = h[HM_NU + i] + ocp_qp_kkt_dot4(A + i * HM_NX, pb) - K0[i] * c0 - K1[i] * c1;
+            }
         }
     }
 }
@@ -180,9 +208,13 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp
     u[1] = -v1;
     for (i = 0; i < HM_NX; i++) xnew[i] = sn->ry[i] - B[i] * v0 - B[i + HM_NX] * v1;
     if (n > 0) {
-        for (k = 0; k < HM_NX; k++) {
+        for (k = sn->a_id ? 2 : 0; k < HM_NX; k++) {
             const hm_real xk = x[k];
             for (i = 0; i < HM_NX; i++) xnew[i] += A[i + k * HM_NX] * xk;
+        }
+        if (sn->a_id) {
+            xnew[0] += x[0];
+            xnew[1] += x[1];
         }
     }
     ocp_qp_kkt_mv4(sn1->P, xnew, t);

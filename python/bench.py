@@ -80,7 +80,7 @@ class CrowdScene:
 
     def __init__(self, k: int, rng: np.random.Generator, robot_xy: np.ndarray) -> None:
         self.rng = rng
-        pos = []
+        pos: list[np.ndarray] = []
         while len(pos) < k:
             p = np.array([rng.uniform(1.0, 12.0), rng.uniform(*AREA_Y)])
             if np.linalg.norm(p - robot_xy) > 2.0:

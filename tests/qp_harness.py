@@ -566,6 +566,7 @@ class Shape:
     l1_only: bool = False  # soft rows with Zl = 0
     duplicate_rows: bool = False
     scale: float = 1.0  # magnitude of the linear cost terms (pulls the optimum onto bounds)
+    position_free_dynamics: bool = False  # A = [e_0 e_1 * *] on most stages, as the robot's (the solver's fast path)
 
 
 def empty_qp(N: int, NG: int) -> QP:
@@ -589,6 +590,12 @@ def random_qp(rng: np.random.Generator, N: int, NG: int, shape: Shape = Shape())
     (qp, x_ref, u_ref)); soft rows are placed anywhere, often violated at the optimum."""
     qp = empty_qp(N, NG)
     qp.A[:] = np.eye(NX) + 0.3 * rng.standard_normal((N, NX, NX))
+    if shape.position_free_dynamics:
+        # the position does not enter the dynamics (columns 0 and 1 unit vectors), except on a few
+        # stages, so that both kernels of the Riccati recursion meet in one QP
+        plain = rng.random(N) < 0.8
+        qp.A[plain, :, 0] = np.eye(NX)[0]
+        qp.A[plain, :, 1] = np.eye(NX)[1]
     qp.B[:] = 0.5 * rng.standard_normal((N, NX, NU))
     qp.b[:] = 0.1 * rng.standard_normal((N, NX))
     qp.x0[:] = rng.standard_normal(NX)

@@ -91,6 +91,7 @@ shapes = st.builds(
     l1_only=st.booleans(),
     duplicate_rows=st.booleans(),
     scale=st.sampled_from([0.1, 1.0, 10.0]),
+    position_free_dynamics=st.booleans(),
 )
 seeds = st.integers(min_value=0, max_value=2**32 - 1)
 
