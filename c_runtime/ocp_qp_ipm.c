@@ -39,6 +39,10 @@
 #define OCP_QP_IPM_W_MAX_REL HM_R(1e10)
 #endif
 
+/* The termination tests measure the inequalities once the residuals are within this factor of
+ * passing on the stage vectors' normalisation alone (ocp_qp_ipm_solve). */
+#define OCP_QP_IPM_MEASURE_NEAR HM_R(1e3)
+
 /* Iterations over which a feasible iterate's mu must fall by 4 (ocp_qp_ipm_solve). */
 #define OCP_QP_IPM_STALL_ITERS 4
 
@@ -282,13 +286,17 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
  * Pass A: step, residuals, weights, condensation
  * ---------------------------------------------------------------------------------------------- */
 
-/* Scalars of one residual evaluation. */
+/* Scalars of one residual evaluation. Pass A computes the sums, the residual norms and the norms
+ * of the stage vectors; the norms over the inequalities (av_ineq .. pv_s) only enter the
+ * termination tests' normalisation, the natural residual and the certificate test, and are
+ * computed by ocp_qp_ipm_row_measures only when one of those tests can pass (ocp_qp_ipm_solve). */
 typedef struct {
     hm_real qv, bw, vPv, tz;          /* q' v, b' w, v' P v, t' z */
-    hm_real atw, pv, av_eq, av_ineq;  /* inf-norms of A' w, P v, A_E v, A_I v + t */
+    hm_real atw, pv, av_eq;           /* inf-norms over (u, x) of A' w and P v; of A_E v */
     hm_real rd, rp;                   /* inf-norms of the dual and primal residuals */
-    hm_real nv, nw, nt;               /* inf-norms of v, w, t */
+    hm_real av_ineq, nt;              /* inf-norms of A_I v + t and of t */
     hm_real ncr;                      /* max over inequalities of min(t, z) */
+    hm_real atw_s, pv_s;              /* inf-norms over the soft slacks of A' w and P v */
 } ocp_qp_ipm_sums;
 
 /* y = H_n x for the (scaled) cost Hessian [R S; S' Q] of stage n on (u, x); parts absent at stage 0
@@ -323,8 +331,8 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
 {
     const hm_real wmax = ws->w_max;
     hm_real qv = HM_R(0.0), bw = HM_R(0.0), vPv = HM_R(0.0), tz = HM_R(0.0);
-    hm_real atw_n = HM_R(0.0), pv_n = HM_R(0.0), aveq_n = HM_R(0.0), avin_n = HM_R(0.0);
-    hm_real rd = HM_R(0.0), rp = HM_R(0.0), nv = HM_R(0.0), nw = HM_R(0.0), nt = HM_R(0.0), ncr = HM_R(0.0);
+    hm_real atw_n = HM_R(0.0), pv_n = HM_R(0.0), aveq_n = HM_R(0.0);
+    hm_real rd = HM_R(0.0), rp = HM_R(0.0);
     int n, i, j, k, l;
 
     for (n = 0; n <= HM_N; n++) {
@@ -349,9 +357,18 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             hm_real e[HM_NX];
             for (i = 0; i < HM_NX; i++) e[i] = ux[HM_NU + i] - B[i] * up[0] - B[i + HM_NX] * up[1];
             if (n > 1) {
-                for (k = 0; k < HM_NX; k++) {
-                    const hm_real xk = up[HM_NU + k];
-                    for (i = 0; i < HM_NX; i++) e[i] -= A[i + k * HM_NX] * xk;
+                if (sp->a_id) {
+                    e[0] -= up[HM_NU];
+                    e[1] -= up[HM_NU + 1];
+                    for (k = 2; k < HM_NX; k++) {
+                        const hm_real xk = up[HM_NU + k];
+                        for (i = 0; i < HM_NX; i++) e[i] -= A[i + k * HM_NX] * xk;
+                    }
+                } else {
+                    for (k = 0; k < HM_NX; k++) {
+                        const hm_real xk = up[HM_NU + k];
+                        for (i = 0; i < HM_NX; i++) e[i] -= A[i + k * HM_NX] * xk;
+                    }
                 }
             }
             for (i = 0; i < HM_NX; i++) {
@@ -368,10 +385,7 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             const hm_real *restrict y = sn->y;
             atw[0] = -(B[0] * y[0] + B[1] * y[1] + B[2] * y[2] + B[3] * y[3]);
             atw[1] = -(B[4] * y[0] + B[5] * y[1] + B[6] * y[2] + B[7] * y[3]);
-            for (i = 0; i < HM_NX; i++) {
-                bw += sn->beq[i] * y[i];
-                nw = OCP_QP_IPM_MAX(nw, OCP_QP_IPM_ABS(y[i]));
-            }
+            bw += (sn->beq[0] * y[0] + sn->beq[1] * y[1]) + (sn->beq[2] * y[2] + sn->beq[3] * y[3]);
         } else {
             atw[0] = atw[1] = HM_R(0.0);
         }
@@ -381,9 +395,13 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             if (n < HM_N) {
                 const hm_real *restrict A = qp->A[n];
                 const hm_real *restrict y = sn->y;
-                for (i = 0; i < HM_NX; i++) {
+                for (i = sn->a_id ? 2 : 0; i < HM_NX; i++) {
                     const hm_real *restrict a = &A[i * HM_NX];
                     atw[HM_NU + i] -= (a[0] * y[0] + a[1] * y[1]) + (a[2] * y[2] + a[3] * y[3]);
+                }
+                if (sn->a_id) {
+                    atw[HM_NU] -= y[0];
+                    atw[HM_NU + 1] -= y[1];
                 }
             }
         } else {
@@ -395,7 +413,7 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             Hd[i] = HM_R(0.0);
         }
 
-        /* bound pairs: the two sides as two lanes */
+        /* bound pairs: the two sides as two lanes (an absent side has sign 0 and stays at t = z = 1) */
         for (k = 0; k < sn->nbp; k++) {
             const int c = sn->bc[k];
             const hm_real v = ux[c];
@@ -406,12 +424,10 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                 const hm_real t = msk * (sn->bt[k][l] + alpha * sn->bdt[k][l]) + (HM_R(1.0) - msk);
                 const hm_real z = msk * (sn->bz[k][l] + alpha * sn->bdz[k][l]) + (HM_R(1.0) - msk);
                 const hm_real b = sn->bb[k][l];
-                const hm_real av = sg * v + t;
-                const hm_real r = av - b;
+                const hm_real rho = sg * v - b;
                 const hm_real inv = HM_R(1.0) / (t * z);
                 const hm_real ti = z * inv, zi = t * inv;
                 const hm_real w = OCP_QP_IPM_MIN(z * ti, wmax);
-                const hm_real rho = sg * v - b;
                 sn->bt[k][l] = t;
                 sn->bz[k][l] = z;
                 sn->bw[k][l] = w;
@@ -423,11 +439,7 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                 hf_l[l] = sg * w * rho;
                 mu_l[l] = sg * w * zi;
                 tz += msk * t * z;
-                ncr = OCP_QP_IPM_MAX(ncr, msk * OCP_QP_IPM_MIN(t, z));
-                rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_ABS(r));
-                avin_n = OCP_QP_IPM_MAX(avin_n, msk * OCP_QP_IPM_ABS(av));
-                nt = OCP_QP_IPM_MAX(nt, msk * t);
-                nw = OCP_QP_IPM_MAX(nw, msk * z);
+                rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_ABS(rho + t));
                 bw += msk * b * z;
             }
             atw[c] += a_l[0] + a_l[1];
@@ -445,10 +457,6 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             hm_real tz_l[2] = {HM_R(0.0), HM_R(0.0)}, bw_l[2] = {HM_R(0.0), HM_R(0.0)};
             hm_real qv_l[2] = {HM_R(0.0), HM_R(0.0)}, vPv_l[2] = {HM_R(0.0), HM_R(0.0)};
             hm_real rp_l[2] = {HM_R(0.0), HM_R(0.0)}, rd_l[2] = {HM_R(0.0), HM_R(0.0)};
-            hm_real atw_l[2] = {HM_R(0.0), HM_R(0.0)}, pv_l[2] = {HM_R(0.0), HM_R(0.0)};
-            hm_real av_l[2] = {HM_R(0.0), HM_R(0.0)}, nv_l[2] = {HM_R(0.0), HM_R(0.0)};
-            hm_real nt_l[2] = {HM_R(0.0), HM_R(0.0)}, nw_l[2] = {HM_R(0.0), HM_R(0.0)};
-            hm_real nc_l[2] = {HM_R(0.0), HM_R(0.0)};
 
             /* soft rows, in pairs */
             for (j = 0; j < sn->ns2; j += 2) {
@@ -461,8 +469,7 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                     const hm_real zs = msk * (sn->szs[q] + alpha * sn->sdzs[q]) + (HM_R(1.0) - msk);
                     const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q], lg = sn->slg[q], Zl = sn->sZl[q];
                     const hm_real gp = d0 * p0 + d1 * p1;
-                    const hm_real av = t - gp - s;
-                    const hm_real rr = av + lg;
+                    const hm_real rho = lg - gp - s;
                     const hm_real rs = Zl * s + sn->szl[q] - z - zs;
                     const hm_real ia = HM_R(1.0) / (t * z), ib = HM_R(1.0) / (s * zs);
                     const hm_real ti = z * ia, zi = t * ia, si = zs * ib, zsi = s * ib;
@@ -470,10 +477,8 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                     const hm_real hinv = HM_R(1.0) / (Zl + wr + wsl);
                     const hm_real hw = hinv * wr;
                     const hm_real we = hw * (Zl + wsl);
-                    const hm_real rho = lg - gp - s;
                     const hm_real e = we * rho + hw * (rs + wsl * s);
                     const hm_real cmu = we * zi - hw * wsl * zsi;
-                    const hm_real ast = z + zs;
                     sn->ss[q] = s;
                     sn->st[q] = t;
                     sn->sz[q] = z;
@@ -496,18 +501,11 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                     a0[l] -= d0 * z;
                     a1[l] -= d1 * z;
                     tz_l[l] += msk * (t * z + s * zs);
-                    nc_l[l] = OCP_QP_IPM_MAX(nc_l[l], msk * OCP_QP_IPM_MAX(OCP_QP_IPM_MIN(t, z), OCP_QP_IPM_MIN(s, zs)));
                     bw_l[l] -= msk * lg * z;
                     qv_l[l] += msk * sn->szl[q] * s;
                     vPv_l[l] += msk * Zl * s * s;
-                    rp_l[l] = OCP_QP_IPM_MAX(rp_l[l], OCP_QP_IPM_ABS(rr));
+                    rp_l[l] = OCP_QP_IPM_MAX(rp_l[l], OCP_QP_IPM_ABS(t + rho));
                     rd_l[l] = OCP_QP_IPM_MAX(rd_l[l], OCP_QP_IPM_ABS(rs));
-                    atw_l[l] = OCP_QP_IPM_MAX(atw_l[l], msk * ast);
-                    pv_l[l] = OCP_QP_IPM_MAX(pv_l[l], msk * OCP_QP_IPM_ABS(Zl * s));
-                    av_l[l] = OCP_QP_IPM_MAX(av_l[l], msk * OCP_QP_IPM_ABS(av));
-                    nv_l[l] = OCP_QP_IPM_MAX(nv_l[l], msk * s);
-                    nt_l[l] = OCP_QP_IPM_MAX(nt_l[l], msk * t);
-                    nw_l[l] = OCP_QP_IPM_MAX(nw_l[l], msk * OCP_QP_IPM_MAX(z, zs));
                 }
             }
             /* hard rows, in pairs */
@@ -518,13 +516,10 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                     const hm_real t = msk * (sn->ht[q] + alpha * sn->hdt[q]) + (HM_R(1.0) - msk);
                     const hm_real z = msk * (sn->hz[q] + alpha * sn->hdz[q]) + (HM_R(1.0) - msk);
                     const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q], lg = sn->hlg[q];
-                    const hm_real gp = d0 * p0 + d1 * p1;
-                    const hm_real av = t - gp;
-                    const hm_real rr = av + lg;
+                    const hm_real rho = lg - (d0 * p0 + d1 * p1);
                     const hm_real ia = HM_R(1.0) / (t * z);
                     const hm_real ti = z * ia, zi = t * ia;
                     const hm_real w = OCP_QP_IPM_MIN(z * ti, wmax);
-                    const hm_real rho = lg - gp;
                     const hm_real wr = w * rho, wz = w * zi;
                     sn->ht[q] = t;
                     sn->hz[q] = z;
@@ -541,12 +536,8 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                     a0[l] -= d0 * z;
                     a1[l] -= d1 * z;
                     tz_l[l] += msk * t * z;
-                    nc_l[l] = OCP_QP_IPM_MAX(nc_l[l], msk * OCP_QP_IPM_MIN(t, z));
                     bw_l[l] -= msk * lg * z;
-                    rp_l[l] = OCP_QP_IPM_MAX(rp_l[l], OCP_QP_IPM_ABS(rr));
-                    av_l[l] = OCP_QP_IPM_MAX(av_l[l], msk * OCP_QP_IPM_ABS(av));
-                    nt_l[l] = OCP_QP_IPM_MAX(nt_l[l], msk * t);
-                    nw_l[l] = OCP_QP_IPM_MAX(nw_l[l], msk * z);
+                    rp_l[l] = OCP_QP_IPM_MAX(rp_l[l], OCP_QP_IPM_ABS(t + rho));
                 }
             }
             sn->Hpp[0] = h00[0] + h00[1];
@@ -564,13 +555,6 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             vPv += vPv_l[0] + vPv_l[1];
             rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_MAX(rp_l[0], rp_l[1]));
             rd = OCP_QP_IPM_MAX(rd, OCP_QP_IPM_MAX(rd_l[0], rd_l[1]));
-            atw_n = OCP_QP_IPM_MAX(atw_n, OCP_QP_IPM_MAX(atw_l[0], atw_l[1]));
-            pv_n = OCP_QP_IPM_MAX(pv_n, OCP_QP_IPM_MAX(pv_l[0], pv_l[1]));
-            avin_n = OCP_QP_IPM_MAX(avin_n, OCP_QP_IPM_MAX(av_l[0], av_l[1]));
-            nv = OCP_QP_IPM_MAX(nv, OCP_QP_IPM_MAX(nv_l[0], nv_l[1]));
-            nt = OCP_QP_IPM_MAX(nt, OCP_QP_IPM_MAX(nt_l[0], nt_l[1]));
-            ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MAX(nc_l[0], nc_l[1]));
-            nw = OCP_QP_IPM_MAX(nw, OCP_QP_IPM_MAX(nw_l[0], nw_l[1]));
         } else {
             sn->Hpp[0] = sn->Hpp[1] = sn->Hpp[2] = HM_R(0.0);
         }
@@ -582,14 +566,14 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             sn->ha[i] = ri + hf[i];
             sn->hmu[i] = hmu[i];
             sn->Hd[i] = Hd[i];
-            if (i >= c0 && i < c1) {
-                qv += sn->q[i] * ux[i];
-                vPv += Pux[i] * ux[i];
-                atw_n = OCP_QP_IPM_MAX(atw_n, OCP_QP_IPM_ABS(atw[i]));
-                pv_n = OCP_QP_IPM_MAX(pv_n, OCP_QP_IPM_ABS(Pux[i]));
-                rd = OCP_QP_IPM_MAX(rd, OCP_QP_IPM_ABS(ri));
-                nv = OCP_QP_IPM_MAX(nv, OCP_QP_IPM_ABS(ux[i]));
-            }
+        }
+        for (i = c0; i < c1; i++) {
+            const hm_real ri = Pux[i] + sn->q[i] + atw[i];
+            qv += sn->q[i] * ux[i];
+            vPv += Pux[i] * ux[i];
+            atw_n = OCP_QP_IPM_MAX(atw_n, OCP_QP_IPM_ABS(atw[i]));
+            pv_n = OCP_QP_IPM_MAX(pv_n, OCP_QP_IPM_ABS(Pux[i]));
+            rd = OCP_QP_IPM_MAX(rd, OCP_QP_IPM_ABS(ri));
         }
     }
     sm->qv = qv;
@@ -599,13 +583,52 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
     sm->atw = atw_n;
     sm->pv = pv_n;
     sm->av_eq = aveq_n;
-    sm->av_ineq = avin_n;
     sm->rd = rd;
     sm->rp = rp;
-    sm->nv = nv;
-    sm->nw = nw;
+    /* not measured yet: neutral for the normalisation and the certificate, and no natural residual
+     * small enough to declare a solution */
+    sm->av_ineq = sm->nt = sm->atw_s = sm->pv_s = HM_R(0.0);
+    sm->ncr = HM_INF;
+}
+
+/* The norms over the inequalities of the iterate left by pass A (see ocp_qp_ipm_sums). */
+HM_FUNC void ocp_qp_ipm_row_measures(const hm_ocp_qp_ipm_ws *restrict ws, ocp_qp_ipm_sums *restrict sm)
+{
+    hm_real av = HM_R(0.0), nt = HM_R(0.0), ncr = HM_R(0.0), atw_s = HM_R(0.0), pv_s = HM_R(0.0);
+    int n, k, l, j;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+        const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
+        for (k = 0; k < sn->nbp; k++) {
+            for (l = 0; l < 2; l++) {
+                const hm_real sg = sn->bsg[k][l], t = sn->bt[k][l], z = sn->bz[k][l];
+                if (sg == HM_R(0.0)) continue;
+                av = OCP_QP_IPM_MAX(av, OCP_QP_IPM_ABS(sg * sn->ux[sn->bc[k]] + t));
+                nt = OCP_QP_IPM_MAX(nt, t);
+                ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MIN(t, z));
+            }
+        }
+        if (n == 0) continue;
+        for (j = 0; j < sn->ns; j++) {
+            const hm_real t = sn->st[j], z = sn->sz[j], s = sn->ss[j], zs = sn->szs[j];
+            av = OCP_QP_IPM_MAX(av, OCP_QP_IPM_ABS(t - (sn->sd0[j] * p0 + sn->sd1[j] * p1) - s));
+            nt = OCP_QP_IPM_MAX(nt, t);
+            ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MAX(OCP_QP_IPM_MIN(t, z), OCP_QP_IPM_MIN(s, zs)));
+            atw_s = OCP_QP_IPM_MAX(atw_s, z + zs);
+            pv_s = OCP_QP_IPM_MAX(pv_s, OCP_QP_IPM_ABS(sn->sZl[j] * s));
+        }
+        for (j = 0; j < sn->nh; j++) {
+            const hm_real t = sn->ht[j], z = sn->hz[j];
+            av = OCP_QP_IPM_MAX(av, OCP_QP_IPM_ABS(t - (sn->hd0[j] * p0 + sn->hd1[j] * p1)));
+            nt = OCP_QP_IPM_MAX(nt, t);
+            ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MIN(t, z));
+        }
+    }
+    sm->av_ineq = av;
     sm->nt = nt;
     sm->ncr = ncr;
+    sm->atw_s = atw_s;
+    sm->pv_s = pv_s;
 }
 
 /* ------------------------------------------------------------------------------------------------
@@ -1459,15 +1482,28 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
             rp0 = sm.rp;
         }
         ws->mu = mu;
-        if (!isfinite(mu + sm.rd + sm.rp + sm.nv + sm.nw + sm.bw + sm.vPv)) {
+        /* a NaN anywhere in the iterate reaches one of these sums (t, z, s through t'z; v through
+         * q'v and v'Pv, which multiply every entry; y through b'w) */
+        if (!isfinite(mu + sm.rd + sm.rp + sm.qv + sm.bw + sm.vPv)) {
             status = HM_QP_NONFINITE;
             break;
         }
 
-        /* termination tests */
-        res_p = sm.rp / OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_b),
-                                       OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(sm.av_eq, sm.av_ineq), sm.nt));
-        res_d = sm.rd / OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_q), OCP_QP_IPM_MAX(sm.pv, sm.atw));
+        /* termination tests. Their normalisations take the norms of the stage vectors and, where
+         * the residuals are within OCP_QP_IPM_MEASURE_NEAR of passing already (or the iterate may
+         * be a certificate), the norms over the inequalities: those only ever enlarge the
+         * normalisation, and cost a pass over the rows. */
+        {
+            const hm_real np_stage = OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_b), sm.av_eq);
+            const hm_real nd_stage = OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_q), OCP_QP_IPM_MAX(sm.pv, sm.atw));
+            if ((sm.rp <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * np_stage
+                 && sm.rd <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * nd_stage)
+                || (sm.bw < HM_R(0.0) && sm.atw <= arg->tol_infeas * -sm.bw))
+                ocp_qp_ipm_row_measures(ws, &sm);
+            res_p = sm.rp / OCP_QP_IPM_MAX(np_stage, OCP_QP_IPM_MAX(sm.av_ineq, sm.nt));
+            res_d = sm.rd / OCP_QP_IPM_MAX(nd_stage, OCP_QP_IPM_MAX(sm.pv_s, sm.atw_s));
+            sm.atw = OCP_QP_IPM_MAX(sm.atw, sm.atw_s);
+        }
         /* the complementarity t' z (= primal - dual cost once the residuals vanish, but without the
          * cancellation of those two large numbers), absolute and relative to the cost, in the units
          * of the data */

@@ -118,7 +118,8 @@ def make_parser() -> argparse.ArgumentParser:
                        "DIR/build/lib<name>.so and .a.")
     p.add_argument("dir", type=Path, help="generated solver folder")
     p.add_argument("--cc", help="C compiler (default: $CC or cc)")
-    p.add_argument("--cflags", help="compiler flags (default: $CFLAGS or -O2)")
+    p.add_argument("--cflags", help="compiler flags (default: $CFLAGS, or tuned to this machine: "
+                   "-O2 -march=native -funroll-loops -ffp-contract=off)")
     p.set_defaults(func=_cmd_build)
 
     p = sub.add_parser("info", help="describe a generated package: sizes, files, functions",
