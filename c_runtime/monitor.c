@@ -73,6 +73,7 @@ HM_FUNC int monitor_check_params(const hm_params *p)
     if (!monitor_finite(p->deadline_ms) || p->deadline_ms <= HM_R(0.0)) return 0;
     if (p->qp_max_iter < 1 || p->qp_max_iter > 1000) return 0;
     if (p->line_search != 0 && p->line_search != 1) return 0;
+    if (p->exact_hessian != 0 && p->exact_hessian != 1) return 0;
     return 1;
 }
 

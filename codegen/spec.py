@@ -243,6 +243,12 @@ class Solver:
     line_search: bool = boolean(
         False, "RTI: damp the QP step by a backtracking line search on the l1 merit (false: full step)"
     )
+    hessian: str = choice(
+        "gauss_newton",
+        "RTI Hessian: gauss_newton (acados' default), or exact: the Hessian of the Lagrangian at the shifted "
+        "multipliers, projected per stage onto the PSD cone (no omega chatter when the goal is far)",
+        ("gauss_newton", "exact"),
+    )
 
 
 @dataclass(frozen=True)

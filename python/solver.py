@@ -258,9 +258,9 @@ class Solver:
                     raise ValueError(f"qp_max_iter must be an integer in [1, 1000], got {value!r}")
                 staged.append((key, value))
                 continue
-            if key == "line_search":
+            if key in ("line_search", "exact_hessian"):
                 if not isinstance(value, bool) and value not in (0, 1):
-                    raise ValueError(f"line_search must be true or false, got {value!r}")
+                    raise ValueError(f"{key} must be true or false, got {value!r}")
                 staged.append((key, int(value)))
                 continue
             arr = np.asarray(value, dtype=np.float64)
