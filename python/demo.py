@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +33,7 @@ def _fmt(value: object) -> str:
     return str(value)
 
 
-def side_by_side(rows: dict[str, dict[str, object]]) -> str:
+def side_by_side(rows: Mapping[str, Mapping[str, object]]) -> str:
     names = list(rows)
     keys = [k for k in rows[names[0]] if k not in ("scenario", "seed", "planner")]
     width = max(len(k) for k in keys)
