@@ -74,6 +74,7 @@ HM_FUNC int monitor_check_params(const hm_params *p)
     if (p->qp_max_iter < 1 || p->qp_max_iter > 1000) return 0;
     if (p->line_search != 0 && p->line_search != 1) return 0;
     if (p->row_screening != 0 && p->row_screening != 1) return 0;
+    if (p->exact_hessian != 0 && p->exact_hessian != 1) return 0;
     return 1;
 }
 

@@ -314,7 +314,11 @@ HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in)
      * start reads x0 (the caller's guess) already here. */
     if (monitor_check_params(&s->params) && monitor_check_input(in, !s->warm)) {
         ocp_nlp_shift(s, in);
-        ocp_nlp_linearize(s, in, 0);
+        /* exact_hessian: the Lagrangian's Hessian at the shifted multipliers of the last QP (a cold
+         * start has none: Gauss-Newton). With the paper's zero control weights and a far goal the
+         * Gauss-Newton model misses the costate-weighted curvature of the dynamics, and its full steps
+         * flip omega between its bounds from one step to the next. */
+        ocp_nlp_linearize(s, in, s->warm && s->params.exact_hessian);
         s->prepared = 1;
     }
     s->time_prepare_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);

@@ -126,6 +126,7 @@ def template_context(spec: Spec, functions: list[EmittedFunction], real: str) ->
         "qp_max_iter": int(spec.solver.qp_max_iter),
         "line_search": 1 if spec.solver.line_search else 0,
         "row_screening": 1 if spec.solver.row_screening else 0,
+        "exact_hessian": 1 if spec.solver.hessian == "exact" else 0,
         "functions": [_function_context(name, ef) for ef in functions],
     }
 

@@ -247,6 +247,12 @@ class Solver:
         True, "leave distance rows far from binding out of each QP and check them at its solution (re-solving "
         "with any that are violated): the same solution, at the cost of the rows that matter"
     )
+    hessian: str = choice(
+        "gauss_newton",
+        "RTI Hessian: gauss_newton (acados' default), or exact: the Hessian of the Lagrangian at the shifted "
+        "multipliers, projected per stage onto the PSD cone (no omega chatter when the goal is far)",
+        ("gauss_newton", "exact"),
+    )
 
 
 @dataclass(frozen=True)

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from humanmpc.global_path import GridConfig, local_segment, plan_path
+from humanmpc.global_path import GlobalPlanner, GridConfig, local_segment
 from humanmpc.planner import Observation, PlanResult, protective_stop
 from humanmpc.robot import integrate
 
@@ -169,39 +169,25 @@ class DWBPlanner:
 
     def __init__(self, config: DWBConfig | None = None) -> None:
         self.config = config or DWBConfig()
-        self._path: FloatArray | None = None
-        self._path_goal: FloatArray | None = None
-        self._planned_at = -np.inf
+        self._global = GlobalPlanner(self.config.grid, self.config.replan_period)
 
     def reset(self) -> None:
-        self._path = None
-        self._path_goal = None
-        self._planned_at = -np.inf
+        self._global.reset()
 
     @property
     def global_path(self) -> FloatArray | None:
-        return None if self._path is None else self._path.copy()
-
-    def _update_global_path(self, obs: Observation) -> float:
-        goal_xy = np.asarray(obs.goal[:2], dtype=float)
-        stale = obs.time - self._planned_at >= self.config.replan_period - 1e-9
-        if self._path is None or self._path_goal is None or stale or not np.array_equal(goal_xy, self._path_goal):
-            t0 = time.perf_counter()
-            robot = obs.robot
-            self._path = plan_path(
-                obs.world, obs.x[:2], goal_xy, robot.radius, obs.humans_now, robot.human_radius, self.config.grid
-            )
-            self._path_goal = goal_xy
-            self._planned_at = obs.time
-            return (time.perf_counter() - t0) * 1e3
-        return 0.0
+        return self._global.path
 
     def plan(self, obs: Observation) -> PlanResult:
-        global_ms = self._update_global_path(obs)
-        assert self._path is not None
+        robot = obs.robot
+        global_ms = self._global.update(
+            obs.time, obs.world, obs.x[:2], obs.goal, robot.radius, obs.humans_now, robot.human_radius
+        )
+        path = self._global.path
+        assert path is not None
         t0 = time.perf_counter()
         cfg = self.config
-        local_path = local_segment(self._path, obs.x[:2], cfg.lookahead)
+        local_path = local_segment(path, obs.x[:2], cfg.lookahead)
         ro = rollout(obs, sample_window(obs, cfg), cfg)
         total, valid = score(obs, ro, local_path, cfg)
         local_ms = (time.perf_counter() - t0) * 1e3

@@ -47,6 +47,7 @@ Row = dict[str, float | int | bool | str]
 def run_job(job: Job, config: EpisodeConfig | None = None) -> tuple[Row, EpisodeLog | None]:
     """Run one episode and return its metrics row (and its log if asked)."""
     log = run_episode(make_scenario(job.scenario, job.seed), make_planner(job.planner), config)
+    log.planner = job.planner  # the registered name (a planner's own name may differ), for the figures
     row: Row = {"scenario": job.scenario, "planner": job.planner, "seed": job.seed}
     row.update(compute_metrics(log).as_row())
     return row, (log if job.keep_log else None)

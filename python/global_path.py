@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import heapq
 import itertools
+import time as _time
 from dataclasses import dataclass
 
 import numpy as np
@@ -153,3 +154,41 @@ def local_segment(path: FloatArray, position: ArrayLike, lookahead: float) -> Fl
     cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(seg, axis=0), axis=1))])
     end = int(np.searchsorted(cum, lookahead, side="right"))
     return seg[: max(2, end)]
+
+
+class GlobalPlanner:
+    """The global planner every local planner of the evaluation shares (nav2's planner server feeding
+    its controller): an A* path from the robot to the goal, replanned every ``replan_period`` seconds
+    and whenever the goal changes, with the humans' current positions as obstacles (nav2's default
+    behaviour tree replans at 1 Hz on a costmap whose obstacle layer sees the people)."""
+
+    def __init__(self, grid: GridConfig | None = None, replan_period: float = 1.0) -> None:
+        if not replan_period > 0:
+            raise ValueError(f"GlobalPlanner: replan_period must be > 0, got {replan_period}")
+        self.grid = grid or GridConfig()
+        self.replan_period = replan_period
+        self.reset()
+
+    def reset(self) -> None:
+        self._path: FloatArray | None = None
+        self._goal: FloatArray | None = None
+        self._planned_at = -np.inf
+
+    @property
+    def path(self) -> FloatArray | None:
+        return None if self._path is None else self._path.copy()
+
+    def update(
+        self, time: float, world: World, position: ArrayLike, goal: ArrayLike, robot_radius: float,
+        humans: ArrayLike | None, human_radius: float,
+    ) -> float:
+        """Replan if the path is stale or the goal moved; returns the time spent planning (ms)."""
+        goal_xy = np.asarray(goal, dtype=float).reshape(-1)[:2]
+        stale = time - self._planned_at >= self.replan_period - 1e-9
+        if self._path is None or self._goal is None or stale or not np.array_equal(goal_xy, self._goal):
+            t0 = _time.perf_counter()
+            self._path = plan_path(world, position, goal_xy, robot_radius, humans, human_radius, self.grid)
+            self._goal = goal_xy
+            self._planned_at = time
+            return (_time.perf_counter() - t0) * 1e3
+        return 0.0

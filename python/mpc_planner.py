@@ -1,19 +1,35 @@
-"""The generated MPC as a planner of the evaluation (registered as "mpc").
+"""The generated MPC as a planner of the evaluation (registered as "mpc" and "mpc_paper").
 
-Per control step it hands the solver what the robot observes: its state, the goal, the humans now
-and their constant-velocity predictions, and the nearest obstacle point. Two things a local
-planner does around the OCP, as the paper's move_base/nav2 plugin does:
+Per control step it hands the solver what the robot observes: its state, a goal, the humans now
+and their constant-velocity predictions, and the nearest obstacle point (the OCP of the paper,
+unchanged). Around the OCP it does what the paper's ROS controller plugin does around it, and
+what the DWB baseline of the evaluation gets as well (:class:`MPCPlannerConfig`):
 
-- the goal checker: v_ref tapers near the goal (v_ref <= 0.5 m/s per metre left), so that the
-  robot stops there instead of circling it at cruising speed (the OCP itself tracks v_ref);
+- the goal it hands the OCP: a carrot ``lookahead`` metres along the global path that the DWB
+  follows too (:class:`~humanmpc.global_path.GlobalPlanner`: A* with the humans' current
+  positions as obstacles, replanned at 1 Hz), with the path's heading there; or, with
+  ``global_path=False``, the final goal itself;
+- the goal checker: v_ref tapers near the final goal (v_ref <= ``goal_taper`` m/s per metre
+  left), so that the robot stops there instead of circling it at cruising speed (the OCP itself
+  tracks v_ref);
+- the speed limit: with ``speed_limit=True`` the OCP's bound on v is min(v_max, v_ref), the cap
+  the DWB samples its speeds under (without it the goal terms drive the MPC at v_max);
+- runtime parameters set on the solver (``params``, e.g. the RTI Hessian);
 - more humans than the solver's N_h: the N_h closest to the robot are passed, which is what
   matters for the hard distance rows and, with f decaying in d, for the cost.
+
+``MPCPlannerConfig.paper()`` is the configuration the evaluation started from: the final goal,
+no speed limit beyond the spec's bounds, the spec's parameters (the paper's values).
 """
 
 from __future__ import annotations
 
 import sys
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -23,11 +39,48 @@ from humanmpc.codegen.resources import PROJECT_ROOT
 from humanmpc.codegen.spec import Spec
 
 from .bindings import load
+from .global_path import GlobalPlanner, GridConfig, local_segment
 from .planner import Observation, PlanResult
 from .solver import Solver
 
 DEFAULT_SOLVER_DIR = PROJECT_ROOT / "generated" / "paper"
 GOAL_TAPER = 0.5  # v_ref <= GOAL_TAPER * distance to the goal
+
+# Runtime parameters of the evaluation's MPC (docs/evaluation.md has the measurements behind them):
+# - exact_hessian: the Gauss-Newton RTI throws omega between its bounds when the goal is metres away;
+# - slack_l1 (obstacle row): 100 is no exact penalty against the speed-tracking weight (250), the
+#   plans cut d_s to the nearest obstacle by up to 0.46 m with nobody near and the robot hits walls;
+#   1000 keeps d_s whenever it can be kept and still yields to the human rows (1e4);
+# - q: with the paper's q = 2 the collision potential (at most q/2 + kappa q d_th / 4 = 3.5 per human
+#   and node) is negligible next to the speed-tracking term (250 (v - v_ref)^2), the robot never
+#   trades speed for distance; q = 50 was chosen on the tuning seeds 100..119 (docs/q_selection.py).
+EVALUATION_PARAMS: Mapping[str, Any] = MappingProxyType({"exact_hessian": 1, "slack_l1": 1000.0, "q": 50.0})
+
+
+@dataclass(frozen=True)
+class MPCPlannerConfig:
+    """What the planner does around the OCP (see the module docstring)."""
+
+    global_path: bool = True
+    lookahead: float | None = None  # carrot distance [m]; None: v_ref * T, the plan's length at v_ref
+    replan_period: float = 1.0
+    grid: GridConfig = field(default_factory=GridConfig)
+    goal_taper: float = GOAL_TAPER
+    approach: bool = True
+    speed_limit: bool = True
+    params: Mapping[str, Any] = field(default_factory=lambda: dict(EVALUATION_PARAMS))
+
+    def __post_init__(self) -> None:
+        if self.lookahead is not None and not self.lookahead > 0:
+            raise ValueError(f"MPCPlannerConfig.lookahead must be > 0 or None, got {self.lookahead}")
+        if not (self.replan_period > 0 and self.goal_taper > 0):
+            raise ValueError(f"MPCPlannerConfig: replan_period and goal_taper must be > 0, got {self}")
+
+    @staticmethod
+    def paper() -> MPCPlannerConfig:
+        """The final goal, the spec's bounds and parameters: the paper's OCP with nothing around it but
+        the goal taper and the choice of the closest N_h humans."""
+        return MPCPlannerConfig(global_path=False, approach=False, speed_limit=False, params={})
 
 
 def ensure_solver(solver_dir: Path = DEFAULT_SOLVER_DIR, spec: Spec | None = None) -> Path:
@@ -45,19 +98,70 @@ def ensure_solver(solver_dir: Path = DEFAULT_SOLVER_DIR, spec: Spec | None = Non
 class MPCPlanner:
     name = "mpc"
 
-    def __init__(self, solver: Solver | None = None) -> None:
+    def __init__(self, solver: Solver | None = None, config: MPCPlannerConfig | None = None,
+                 name: str | None = None) -> None:
         self.solver = solver or load(ensure_solver())
+        self.config = config or MPCPlannerConfig()
+        if name is not None:
+            self.name = name
+        if self.config.params:
+            self.solver.set_params(**dict(self.config.params))
+        self._v_bounds = tuple(self.solver.params["v_bounds"])
+        self._w_goal = tuple(self.solver.params["w_goal"])
+        self._global = GlobalPlanner(self.config.grid, self.config.replan_period)
+        self.last_goal: np.ndarray | None = None  # the goal handed to the OCP at the last step
 
     def reset(self) -> None:
         self.solver.reset()
+        self._global.reset()
+        self.last_goal = None
+
+    def ocp_goal(self, obs: Observation) -> np.ndarray:
+        """The goal handed to the OCP: the carrot on the global path (or the final goal) with the
+        tapered v_ref."""
+        cfg = self.config
+        final = np.array(obs.goal, dtype=float)
+        goal = final.copy()
+        if cfg.global_path:
+            robot = obs.robot
+            self._global.update(obs.time, obs.world, obs.x[:2], final, robot.radius, obs.humans_now,
+                                robot.human_radius)
+            path = self._global.path
+            assert path is not None
+            lookahead = cfg.lookahead if cfg.lookahead is not None else final[3] * self.solver.dims.T
+            segment = local_segment(path, obs.x[:2], lookahead)
+            carrot = segment[-1]
+            if np.linalg.norm(carrot - final[:2]) > 1e-9:  # at the final goal keep its heading
+                direction = segment[-1] - segment[-2]
+                goal[:2] = carrot
+                goal[2] = float(np.arctan2(direction[1], direction[0]))
+        left = float(np.hypot(*(final[:2] - obs.x[:2])))
+        goal[3] = min(final[3], cfg.goal_taper * left)
+        if cfg.approach:
+            # Once the horizon reaches the final goal, a speed to track over all of it makes the plan
+            # loop around the goal to spend its length; the approach drops that weight and lets the
+            # position terms bring the robot to the goal and stop it there.
+            w = list(self._w_goal)
+            if left < final[3] * self.solver.dims.T:
+                w[3] = 0.0
+            if tuple(self.solver.params["w_goal"]) != tuple(w):
+                self.solver.set_params(w_goal=w)
+        return goal
+
+    def _apply_speed_limit(self, v_ref: float) -> None:
+        lo, hi = self._v_bounds
+        bounds = (lo, min(hi, v_ref)) if self.config.speed_limit and v_ref > lo else (lo, hi)
+        if tuple(self.solver.params["v_bounds"]) != bounds:
+            self.solver.set_params(v_bounds=list(bounds))
 
     def plan(self, obs: Observation) -> PlanResult:
         s = self.solver
         if obs.humans_pred.shape[0] != s.dims.N + 1 or abs(obs.dt - s.dims.dt) > 1e-9:
             raise ValueError(f"the episode predicts {obs.humans_pred.shape[0] - 1} intervals of {obs.dt} s; "
                              f"the solver needs {s.dims.N} of {s.dims.dt} s (EpisodeConfig(horizon, dt))")
-        goal = np.array(obs.goal, dtype=float)
-        goal[3] = min(goal[3], GOAL_TAPER * float(np.hypot(*(goal[:2] - obs.x[:2]))))
+        goal = self.ocp_goal(obs)
+        self.last_goal = goal
+        self._apply_speed_limit(float(obs.goal[3]))
         now, pred = obs.humans_now, obs.humans_pred
         if now.shape[0] > s.dims.nh:
             closest = np.argsort(np.linalg.norm(now - obs.x[:2], axis=1))[: s.dims.nh]
@@ -69,3 +173,8 @@ class MPCPlanner:
             timings={"prepare_ms": r.time_prepare_ms, "feedback_ms": r.time_feedback_ms,
                      "qp_iterations": float(r.qp_iterations)},
         )
+
+
+def with_params(config: MPCPlannerConfig, **params: Any) -> MPCPlannerConfig:
+    """``config`` with more runtime parameters (e.g. ``q=20.0``)."""
+    return replace(config, params={**dict(config.params), **params})

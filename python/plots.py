@@ -29,7 +29,7 @@ from humanmpc.episode import EpisodeLog
 from humanmpc.metrics import D_TH, human_distances
 from humanmpc.world import World
 
-PLANNER_COLOURS = {"mpc": "tab:red", "dwb": "tab:blue"}
+PLANNER_COLOURS = {"mpc": "tab:red", "dwb": "tab:blue", "mpc_paper": "tab:orange"}
 _OTHER = ["tab:green", "tab:purple", "tab:orange", "tab:brown"]
 
 

@@ -1,7 +1,9 @@
 """Planners by name: a factory per name, so the CLI and the evaluation can build them.
 
 ``register_planner("mpc", factory)`` adds a planner; the factory takes no argument and returns
-a fresh :class:`~humanmpc.planner.Planner`. The DWB baseline is registered as ``"dwb"``.
+a fresh :class:`~humanmpc.planner.Planner`. The DWB baseline is registered as ``"dwb"``, the
+generated MPC as ``"mpc"`` (the evaluation's configuration) and ``"mpc_paper"`` (the paper's OCP with
+its parameters and the final goal; :class:`~humanmpc.mpc_planner.MPCPlannerConfig`).
 Evaluation workers are forked from the registering process, so registrations made before an
 evaluation starts are visible in the workers.
 """
@@ -44,8 +46,15 @@ def _make_mpc() -> Planner:
     # Imported here: loading the MPC generates and builds its solver when that is missing.
     from humanmpc.mpc_planner import MPCPlanner
 
-    return MPCPlanner()
+    return MPCPlanner(name="mpc")
+
+
+def _make_mpc_paper() -> Planner:
+    from humanmpc.mpc_planner import MPCPlanner, MPCPlannerConfig
+
+    return MPCPlanner(config=MPCPlannerConfig.paper(), name="mpc_paper")
 
 
 register_planner("dwb", DWBPlanner)
 register_planner("mpc", _make_mpc)
+register_planner("mpc_paper", _make_mpc_paper)

@@ -315,7 +315,7 @@ class Solver:
                     raise ValueError(f"qp_max_iter must be an integer in [1, 1000], got {value!r}")
                 staged.append((key, value))
                 continue
-            if key in ("line_search", "row_screening"):
+            if key in ("line_search", "row_screening", "exact_hessian"):
                 if not isinstance(value, bool) and value not in (0, 1):
                     raise ValueError(f"{key} must be true or false, got {value!r}")
                 staged.append((key, int(value)))

@@ -133,13 +133,13 @@ def test_non_finite_or_absurd_value_in_every_input_field_stops_then_clears(fresh
 
 
 @pytest.mark.parametrize(("param", "value"), [("q", np.nan), ("kappa", 0.0), ("w_goal", [1, 1, np.inf, 1]),
-                                              ("d_h", -1.0), ("a_bounds", [0.5, 1.0])])
+                                              ("d_h", -1.0), ("a_bounds", [0.5, 1.0]), ("exact_hessian", 2)])
 def test_invalid_runtime_parameters_stop_before_anything_is_computed(fresh: humanmpc.Solver, param: str,
                                                                        value: object) -> None:
     inp = clean_inputs()
     params = fresh._params  # bypass the Python checks: firmware can write anything into the struct
     saved = getattr(params, param)
-    saved = list(saved) if not isinstance(saved, float) else saved
+    saved = list(saved) if not isinstance(saved, (float, int)) else saved
     setattr(params, param, value)
     r = fresh.step(**inp)
     assert r.reason == "invalid_params" and r.stop_reason == 2

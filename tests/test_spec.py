@@ -96,6 +96,8 @@ MALFORMED = [
     ("integrator: {method: euler}", "integrator.method", "one of rk4"),
     ("integrator: {steps: 0}", "integrator.steps", ">= 1"),
     ("solver: {qp_tol: 0}", "solver.qp_tol", "> 0"),
+    ("solver: {hessian: newton}", "solver.hessian", "one of gauss_newton, exact"),
+    ("solver: {hessian: true}", "solver.hessian", "one of gauss_newton, exact"),
     ("monitor: {deadline_ms: -5}", "monitor.deadline_ms", "> 0"),
     ("name: a\nname: b", "name", "duplicate key"),
     ("[1, 2, 3]", "spec", "mapping"),

@@ -121,6 +121,41 @@ def test_rti_closed_loop_reaches_the_goal_in_an_open_scene(paper: humanmpc.Solve
     assert statuses.count(0) == len(statuses)
 
 
+def omega_in_closed_loop(solver: humanmpc.Solver, goal: np.ndarray, steps: int = 120) -> np.ndarray:
+    """The turn rates the RTI commands driving from the origin towards a goal, nobody around."""
+    solver.reset()
+    x = np.array([0.0, 0.0, 0.0, 0.0])
+    omegas = []
+    for _ in range(steps):
+        r = solver.step(x, tapered_goal(goal, x))
+        assert not r.stop
+        omegas.append(r.u0[1])
+        x = humanmpc_unicycle(x, r.u0)
+    return np.array(omegas)
+
+
+def test_rti_with_the_exact_hessian_steers_smoothly_towards_a_far_offset_goal(paper: humanmpc.Solver) -> None:
+    """A goal 17 m ahead and 1 m to the side: the Gauss-Newton RTI (the paper's zero control weights)
+    throws omega from one bound to the other at almost every step; the exact Hessian does not."""
+    goal = np.array([17.0, 1.0, 0.0, 0.8])
+    try:
+        paper.set_params(exact_hessian=True)
+        exact = omega_in_closed_loop(paper, goal)
+        paper.set_params(exact_hessian=False)
+        gauss_newton = omega_in_closed_loop(paper, goal)
+    finally:
+        paper.set_params(exact_hessian=False)
+    assert np.mean(np.abs(exact)) < 0.1 and np.count_nonzero(np.abs(exact) > 0.5) <= 2  # one turn to the goal
+    assert np.mean(np.abs(gauss_newton)) > 1.0  # the defect the option removes, measured on the same loop
+
+
+def test_spec_solver_hessian_sets_the_default_of_the_runtime_switch(tmp_path: Path) -> None:
+    exact = humanmpc.load(make_solver(tmp_path, {"name": "exact_rti", "solver": {"hessian": "exact"}}))
+    assert exact.params["exact_hessian"] == 1
+    with pytest.raises(ValueError, match="exact_hessian must be true or false"):
+        exact.set_params(exact_hessian=2)
+
+
 def humanmpc_unicycle(x: np.ndarray, u: np.ndarray, substeps: int = 10) -> np.ndarray:
     """The plant: the unicycle integrated finely (not the solver's own RK4 step)."""
     h = DT / substeps
