@@ -104,6 +104,8 @@ typedef struct HM_NS(ocp_qp_ipm_arg) {
     HM_REAL step_frac;       /* fraction of the step to the boundary that is taken */
     HM_REAL min_step;        /* a shorter step means no progress: HM_QP_NUMERICAL */
     int polish;              /* 1: refine a solution on its active set (ocp_qp_ipm.h) */
+    int residuals;           /* 1: ws->res holds the KKT residuals of the returned solution; 0: a solved
+                                QP's are left out (the polish still measures them) */
     int (*should_stop)(void *ctx);   /* polled once per iteration; nonzero ends with HM_QP_TIMEOUT */
     void *stop_ctx;
 } HM_NS(ocp_qp_ipm_arg);

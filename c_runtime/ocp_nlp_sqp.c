@@ -453,13 +453,15 @@ static void ocp_nlp_size_screening(hm_solver *s)
         s->screen_radius[n] = OCP_NLP_SCREEN_MIN + HM_R(2.0) * hm_sqrt(hm_fmax(d2[n], d2[n + 1]));
 }
 
-/* Solve the QP of the current linearisation (its x0 offset set), screened. Returns the QP status. */
-static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int *qp_iter)
+/* Solve the QP of the current linearisation (its x0 offset set), screened; residuals: the caller
+ * reads ipm_ws.res. Returns the QP status. */
+static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int *qp_iter)
 {
     const int screen = s->params.row_screening && s->screen_radius[0] < HM_INF;
     int status, round;
     s->ipm_arg.max_iter = s->params.qp_max_iter;
     s->ipm_arg.tol = tol;
+    s->ipm_arg.residuals = residuals;
     if (screen) ocp_nlp_screen_rows(s);
     for (round = 0;; round++) {
         status = ocp_qp_ipm_solve(&s->qp, &s->qp_sol, &s->ipm_ws, &s->ipm_arg);
@@ -517,7 +519,7 @@ static void ocp_nlp_take_multipliers(hm_solver *s)
 /* Solve the QP; when usable, take the full step (real-time iteration). */
 static int ocp_nlp_qp_step(hm_solver *s, int *qp_iter)
 {
-    const int status = ocp_nlp_qp_solve(s, s->params.qp_tol, qp_iter);
+    const int status = ocp_nlp_qp_solve(s, s->params.qp_tol, 0, qp_iter);
     if (!ocp_nlp_qp_usable(status)) return status;
     ocp_nlp_save_base(s);
     ocp_nlp_step_from_base(s, HM_R(1.0));
@@ -570,7 +572,7 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
 static int ocp_nlp_qp_line_search_step(hm_solver *s, const hm_input *in, hm_real tol, int *qp_iter)
 {
     /* The QP must be solved at least as tightly as the SQP is asked to converge. */
-    const int status = ocp_nlp_qp_solve(s, hm_fmin(s->params.qp_tol, HM_R(0.1) * tol), qp_iter);
+    const int status = ocp_nlp_qp_solve(s, hm_fmin(s->params.qp_tol, HM_R(0.1) * tol), 1, qp_iter);
     hm_real gaps = HM_R(0.0), pi_max = HM_R(0.0), merit0, predicted, alpha = HM_R(1.0);
     int n, i;
     if (!ocp_nlp_qp_usable(status)) return status;

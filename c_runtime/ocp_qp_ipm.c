@@ -65,6 +65,7 @@ HM_FUNC void ocp_qp_ipm_arg_set_default(hm_ocp_qp_ipm_arg *arg)
     arg->step_frac = HM_R(0.99);
     arg->min_step = HM_R(1e-8);
     arg->polish = 0;
+    arg->residuals = 1;
     arg->should_stop = NULL;
     arg->stop_ctx = NULL;
 }
@@ -1405,7 +1406,7 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
 /* Ends a solve: the solution, the certificate (with b' w = bw) or zeros (before the first iterate,
  * or for non-finite iterates) into sol, its residuals into ws->res. */
 HM_FUNC int ocp_qp_ipm_finish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws, int status,
-                              hm_real bw, int have_iterate, int polish, hm_real alpha)
+                              hm_real bw, int have_iterate, int polish, int residuals, hm_real alpha)
 {
     if (status == HM_QP_INFEASIBLE) {
         ocp_qp_ipm_write_sol(qp, ws, sol, HM_R(1.0) / -bw, HM_R(0.0));
@@ -1414,9 +1415,13 @@ HM_FUNC int ocp_qp_ipm_finish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
     } else {
         ocp_qp_ipm_write_sol(qp, ws, sol, HM_R(1.0) / ws->cost_scale, HM_R(1.0));
     }
-    ocp_qp_res_compute(qp, sol, &ws->res);
-    if (status == HM_QP_SOLVED && (polish == 1 || (polish == 2 && ocp_qp_ipm_undecided(ws, alpha))))
-        ocp_qp_ipm_polish(qp, sol, ws, alpha);
+    polish = status == HM_QP_SOLVED && (polish == 1 || (polish == 2 && ocp_qp_ipm_undecided(ws, alpha)));
+    if (residuals || polish || status != HM_QP_SOLVED) {
+        ocp_qp_res_compute(qp, sol, &ws->res);
+    } else {
+        ws->res.stat = ws->res.eq = ws->res.ineq = ws->res.comp = ws->res.dual = ws->res.obj = HM_R(0.0);
+    }
+    if (polish) ocp_qp_ipm_polish(qp, sol, ws, alpha);
     ws->status = status;
     return status;
 }
@@ -1460,7 +1465,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
     ws->res_primal = ws->res_dual = ws->gap = ws->mu = HM_R(0.0);
 
     status = ocp_qp_check(qp);
-    if (status) return ocp_qp_ipm_finish(qp, sol, ws, status, HM_R(0.0), 0, 0, HM_R(0.0));
+    if (status) return ocp_qp_ipm_finish(qp, sol, ws, status, HM_R(0.0), 0, 0, 1, HM_R(0.0));
     status = ocp_qp_ipm_setup(qp, ws, &bad);
     if (status == HM_QP_INFEASIBLE) {
         ocp_qp_ipm_write_box_certificate(qp, sol, bad);
@@ -1654,5 +1659,5 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         ws->status = status;
         return status;
     }
-    return ocp_qp_ipm_finish(qp, sol, ws, status, sm.bw, 1, arg->polish, alpha);
+    return ocp_qp_ipm_finish(qp, sol, ws, status, sm.bw, 1, arg->polish, arg->residuals, alpha);
 }
