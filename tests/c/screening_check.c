@@ -73,6 +73,7 @@ int main(int argc, char **argv)
             qp_full = solver.qp;
             arg = solver.ipm_arg;
             arg.should_stop = 0;
+            arg.residuals = 1;
             ocp_qp_ipm_solve(&qp_full, &sol_full, &ws_full, &arg);
             ocp_qp_res_compute(&solver.qp, &solver.qp_sol, &r_scr);
             r_full = ws_full.res;
