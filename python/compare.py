@@ -67,7 +67,12 @@ ACADOS_PACKAGE = "comma-deps-acados==0.2.2.post104"
 ACADOS_PYTHON = "3.12"
 PEER_SCRIPT = Path(__file__).resolve().parent / "peers" / "acados_peer.py"
 DEFAULT_ACADOS_VENV = Path(".venv-acados")
-SOLVERS = ("humanmpc", "acados default", "acados fastest", "Ipopt cold", "Ipopt warm")
+SOLVERS = ("humanmpc", "humanmpc exact+LS", "acados default", "acados fastest", "Ipopt cold", "Ipopt warm")
+# The real-time iterations, whose RCSO is also reported over the steps all of them solved.
+RTI_SOLVERS = ("humanmpc", "humanmpc exact+LS", "acados default", "acados fastest")
+# humanmpc's second row: the same generated solver with the exact-Hessian RTI and the merit line search
+# (runtime parameters), the configuration of the behaviour evaluation (docs/evaluation.md).
+EXACT_LS_PARAMS = {"exact_hessian": True, "line_search": True}
 FASTEST = {"cond_N": 5, "qp_iter_max": 50}
 
 
@@ -288,6 +293,8 @@ class SolverStats:
     failures: int = 0
     rcso: float = float("nan")
     rcso_steps: int = 0
+    rcso_common: float = float("nan")  # over the steps every RTI solver of this N_h solved
+    rcso_common_steps: int = 0
     max_violation_m: float = float("nan")
     wall_mean_ms: float = float("nan")
     error: str | None = None
@@ -302,16 +309,32 @@ def _time_stats(s: SolverStats, times: FloatArray) -> None:
 
 
 def _finish(s: SolverStats, nlp: ReferenceNlp, replay: Replay, u: FloatArray, ok: NDArray[np.bool_],
-            optimal: FloatArray | None) -> None:
+            optimal: FloatArray | None) -> FloatArray:
     """RCSO over the steps the solver solved (its failures are counted apart) and the largest
     violation of the human rows by the plans it called solved, over the steps where the
-    reference found the problem feasible."""
+    reference found the problem feasible. Returns the plan costs of the solved steps (NaN
+    elsewhere)."""
     costs, viol = plan_costs(nlp, replay, u)
     feasible = np.isfinite(optimal) if optimal is not None else np.ones(replay.steps, dtype=bool)
     v = viol[ok & feasible & np.isfinite(viol)]
     s.max_violation_m = float(np.max(v)) if v.size else float("nan")
+    solved_costs = np.where(ok, costs, np.nan)
     if optimal is not None:
-        s.rcso, s.rcso_steps = rcso(np.where(ok, costs, np.nan), optimal)
+        s.rcso, s.rcso_steps = rcso(solved_costs, optimal)
+    return solved_costs
+
+
+def common_rcso(group: Sequence[SolverStats], costs: dict[str, FloatArray], optimal: FloatArray | None) -> None:
+    """RCSO of every RTI solver of one N_h over the steps all of them solved: acados fails most
+    steps of this problem, and an RCSO over its few solved steps would compare easy steps with all."""
+    ran = [g for g in group if g.solver in RTI_SOLVERS and g.solver in costs and g.error is None]
+    if optimal is None or len(ran) < 2:
+        return
+    common = np.ones(optimal.shape, dtype=bool)
+    for g in ran:
+        common &= np.isfinite(costs[g.solver])
+    for g in ran:
+        g.rcso_common, g.rcso_common_steps = rcso(np.where(common, costs[g.solver], np.nan), optimal)
 
 
 def _load_spec(item: Spec | str | Path) -> Spec:
@@ -408,17 +431,20 @@ def compare(specs: Sequence[Spec | str | Path], replays: Sequence[Replay | str |
                                       [r.success for r in ipopt_runs.values()])
 
         group: list[SolverStats] = []
-        # -- humanmpc ----------------------------------------------------------------------
-        s = SolverStats("humanmpc", nh, T)
-        if "humanmpc" not in skip:
+        costs: dict[str, FloatArray] = {}
+        # -- humanmpc, as generated and with the exact-Hessian line-search RTI ------------------
+        for label, params in (("humanmpc", None), ("humanmpc exact+LS", EXACT_LS_PARAMS)):
+            if label in skip:
+                continue
+            s = SolverStats(label, nh, T)
             try:
-                run = _run_ours(spec, None if solver_dirs is None else solver_dirs[i], out, replay, say)
+                run = _run_ours(spec, None if solver_dirs is None else solver_dirs[i], out, replay, say, params)
                 _time_stats(s, run.time_ms)
                 s.wall_mean_ms = float(np.mean(run.wall_ms))
                 s.iterations_mean = float(np.mean(run.qp_iterations))
                 s.iterations_max = int(np.max(run.qp_iterations))
                 s.failures = run.failures
-                _finish(s, nlp, replay, run.u, run.status == 0, optimal)
+                costs[label] = _finish(s, nlp, replay, run.u, run.status == 0, optimal)
             except Exception as err:  # reported in the table; the other solvers still run
                 s.error = f"{type(err).__name__}: {err}"
             group.append(s)
@@ -438,7 +464,7 @@ def compare(specs: Sequence[Spec | str | Path], replays: Sequence[Replay | str |
                     s.iterations_mean = float(np.mean(ar.qp_iterations))
                     s.iterations_max = int(np.max(ar.qp_iterations))
                     s.failures = ar.failures
-                    _finish(s, nlp, replay, ar.u, ar.status == 0, optimal)
+                    costs[label] = _finish(s, nlp, replay, ar.u, ar.status == 0, optimal)
                 except Exception as err:  # reported in the table
                     s.error = f"{type(err).__name__}: {err}"
             group.append(s)
@@ -458,6 +484,7 @@ def compare(specs: Sequence[Spec | str | Path], replays: Sequence[Replay | str |
                 s.failures = ir.failures
                 _finish(s, nlp, replay, ir.u, ir.success, optimal)
             group.append(s)
+        common_rcso(group, costs, optimal)
         ours = next((g for g in group if g.solver == "humanmpc" and g.error is None), None)
         for g in group:
             if ours is not None and g.error is None and ours.mean_ms > 0:
@@ -475,17 +502,25 @@ def compare(specs: Sequence[Spec | str | Path], replays: Sequence[Replay | str |
     return report
 
 
-def _run_ours(spec: Spec, solver_dir: str | Path | None, out: Path, replay: Replay, say: Log) -> ReplayRun:
+def _run_ours(spec: Spec, solver_dir: str | Path | None, out: Path, replay: Replay, say: Log,
+              params: dict[str, Any] | None = None) -> ReplayRun:
+    """The replay through the generated solver (generated when no folder is given), with the
+    replay's problem parameters and then ``params`` on top."""
     import humanmpc  # the package itself; imported here so that compare.py loads without a built solver
 
     if solver_dir is None:
-        from humanmpc.codegen.generate import generate
+        solver_dir = out / "solvers" / f"{spec.name}_{spec.humans.max}"
+        if not (solver_dir / "manifest.json").is_file() or params is None:
+            from humanmpc.codegen.generate import generate
 
-        solver_dir = generate(spec, out / "solvers" / f"{spec.name}_{spec.humans.max}", force=True,
-                              log=lambda _m: None)
+            solver_dir = generate(spec, solver_dir, force=True, log=lambda _m: None)
     solver = humanmpc.load(solver_dir)
-    say(f"[compare]   humanmpc ({solver_dir})")
-    return replay_solver(solver, replay, name="humanmpc")
+    say(f"[compare]   humanmpc{'' if not params else ' with ' + str(params)} ({solver_dir})")
+    solver.reset()
+    solver.set_params(**replay.params)
+    if params:
+        solver.set_params(**params)
+    return replay_solver(solver, replay, name="humanmpc", reset=False, apply_params=False)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -541,22 +576,26 @@ def markdown_section(rows: Sequence[SolverStats], machine: dict[str, str], comma
         "not 0 (humanmpc, acados: 4 = QP failure, 3 = minimum step) or Ipopt not solved. RCSO: relative",
         "cumulative sub-optimality against the best Ipopt optimum per step, over the steps the solver solved,",
         "each plan's controls simulated from the measured state and costed by one common function (see",
-        "`humanmpc.compare`). Violation: the largest d_h - d to a human's current position of a plan the",
-        "solver called solved, over the steps Ipopt found feasible (hard rows are not in the cost).",
+        "`humanmpc.compare`); RCSO common: the same over the steps that every real-time iteration of that",
+        "N_h solved (acados fails most steps, and its RCSO alone covers only the steps it solved). Violation:",
+        "the largest d_h - d to a human's current position of a plan the solver called solved, over the steps",
+        "Ipopt found feasible (hard rows are not in the cost). `humanmpc exact+LS`: the same generated solver",
+        "with the runtime parameters exact_hessian and line_search on (the behaviour evaluation's RTI).",
         "",
         "| N_h | solver | mean ms | min ms | max ms | p99 ms | × ours | iterations (mean/max) | failures | RCSO | "
-        "violation m |",
-        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "RCSO common (steps) | violation m |",
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         if r.error is not None:
             lines.append(f"| {r.n_humans} | {r.solver} | not run: {r.error.splitlines()[0][:120]} "
-                         "| | | | | | | | |")
+                         "| | | | | | | | | |")
             continue
+        common = f"{_fmt(r.rcso_common, 3)} ({r.rcso_common_steps})" if r.rcso_common_steps else "–"
         lines.append(
             f"| {r.n_humans} | {r.solver} | {_fmt(r.mean_ms)} | {_fmt(r.min_ms)} | {_fmt(r.max_ms)} | "
             f"{_fmt(r.p99_ms)} | {_fmt(r.ratio_to_ours, 2)} | {_fmt(r.iterations_mean, 3)}/{r.iterations_max} | "
-            f"{r.failures}/{r.steps} | {_fmt(r.rcso, 3)} | {_fmt(r.max_violation_m, 3)} |"
+            f"{r.failures}/{r.steps} | {_fmt(r.rcso, 3)} | {common} | {_fmt(r.max_violation_m, 3)} |"
         )
     lines += [
         "",

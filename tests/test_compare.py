@@ -41,6 +41,12 @@ def test_compare_writes_table_plot_and_json(tmp_path: Path) -> None:
         assert ours["ratio_to_ours"] == pytest.approx(1.0)
         assert cold["ratio_to_ours"] == pytest.approx(cold["mean_ms"] / ours["mean_ms"])
         assert np.isfinite(ours["rcso"]) and ours["rcso_steps"] == 6
+        exact = by[(n, "humanmpc exact+LS")]
+        assert exact["error"] is None and exact["rcso_steps"] == 6
+        # RCSO over the steps every real-time iteration solved: the same steps for all of them
+        commons = {r["rcso_common_steps"] for r in rows if r["n_humans"] == n and r["solver"] in
+                   ("humanmpc", "humanmpc exact+LS", "acados default", "acados fastest") and r["error"] is None}
+        assert len(commons) == 1 and 0 < commons.pop() <= 6
         for label in ("acados default", "acados fastest"):
             row = by[(n, label)]
             if find_python312() is None:
@@ -50,7 +56,7 @@ def test_compare_writes_table_plot_and_json(tmp_path: Path) -> None:
                 assert row["mean_ms"] > 0 and row["rcso_steps"] >= 1
     out = tmp_path / "out"
     md = (out / "benchmarks.md").read_text()
-    assert md.count("\n| 1 | ") == 5 and md.count("\n| 3 | ") == 5 and "Command: `pytest`" in md
+    assert md.count("\n| 1 | ") == 6 and md.count("\n| 3 | ") == 6 and "Command: `pytest`" in md
     assert "Machine: cpu:" in md
     assert (out / "step_times.png").stat().st_size > 1000
     assert json.loads((out / "results.json").read_text())["command"] == "pytest"
@@ -74,7 +80,7 @@ def test_markdown_reports_solvers_that_did_not_run() -> None:
                         max_violation_m=0.0),
             SolverStats("acados default", 5, 10, error="acados needs Python 3.12 ...")]
     md = markdown_section(rows, {"cpu": "x"}, "cmd")
-    assert "| 5 | humanmpc | 0.500 | 0.400 | 0.700 | 0.690 | 1.00 | 12.000/20 | 1/10 | 0.010 | 0.000 |" in md
+    assert "| 5 | humanmpc | 0.500 | 0.400 | 0.700 | 0.690 | 1.00 | 12.000/20 | 1/10 | 0.010 | – | 0.000 |" in md
     assert "| 5 | acados default | not run: acados needs Python 3.12" in md
 
 
