@@ -106,6 +106,8 @@ typedef struct HM_NS(ocp_qp_ipm_arg) {
     int polish;              /* 1: refine a solution on its active set (ocp_qp_ipm.h) */
     int residuals;           /* 1: ws->res holds the KKT residuals of the returned solution; 0: a solved
                                 QP's are left out (the polish still measures them) */
+    int detect_unbounded;    /* 1: test stalling steps for a ray of unbounded descent (ocp_qp_ipm.h); 0 for
+                                QPs bounded by construction */
     int (*should_stop)(void *ctx);   /* polled once per iteration; nonzero ends with HM_QP_TIMEOUT */
     void *stop_ctx;
 } HM_NS(ocp_qp_ipm_arg);

@@ -30,6 +30,11 @@ HM_FUNC void ocp_nlp_sqp_init(hm_solver *s, const hm_params *params)
 {
     s->params = *params;
     ocp_qp_ipm_arg_set_default(&s->ipm_arg);
+    /* Every QP of the SQP is bounded by construction (box bounds on both inputs of every stage, the
+     * states follow from them, soft slacks cost zl >= 0 and only relax their rows): a ray test could
+     * only give false positives, and in single precision it did (a large early step whose cost
+     * decrease dwarfs its rounding-level residuals, RTI replays with 30 humans). */
+    s->ipm_arg.detect_unbounded = 0;
 #if defined(HM_HAVE_POSIX_CLOCK)
     s->clock = hm_clock_posix_ns;
 #else

@@ -1055,7 +1055,7 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
                 break;
             }
             const hm_real cinv = HM_R(1.0) / ws->cost_scale;
-            if (sm.qv < HM_R(0.0)
+            if (arg->detect_unbounded && sm.qv < HM_R(0.0)
                 && OCP_QP_HSDE_MAX(sm.pv * cinv, OCP_QP_HSDE_MAX(sm.av_eq, sm.av_ineq)) <= arg->tol_infeas * -sm.qv * cinv) {
                 ws->unbounded = 1;
                 status = HM_QP_NUMERICAL;

@@ -66,6 +66,7 @@ HM_FUNC void ocp_qp_ipm_arg_set_default(hm_ocp_qp_ipm_arg *arg)
     arg->min_step = HM_R(1e-8);
     arg->polish = 0;
     arg->residuals = 1;
+    arg->detect_unbounded = 1;
     arg->should_stop = NULL;
     arg->stop_ctx = NULL;
 }
@@ -1542,7 +1543,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         }
         /* a stalling iteration (short steps) may be on a problem without solution: test the last
          * step as a ray (ocp_qp_ipm_farkas, ocp_qp_ipm_unbounded_ray) */
-        if (ws->iter > 0 && alpha < HM_R(0.5)) {
+        if (arg->detect_unbounded && ws->iter > 0 && alpha < HM_R(0.5)) {
             if (ocp_qp_ipm_unbounded_ray(qp, ws, arg->tol_infeas)) {
                 ws->unbounded = 1;
                 status = HM_QP_NUMERICAL;

@@ -35,7 +35,8 @@
  *               are reported before any iteration.
  *   NUMERICAL   a pivot of the Riccati recursion is not safely positive, the step is below
  *               arg->min_step, mu fell below eps^2 mu_0 (the residuals are stuck at their rounding
- *               floor above tol), or a direction of unbounded descent was found: q' v < 0 with
+ *               floor above tol), or (with arg->detect_unbounded) a direction of unbounded
+ *               descent was found: q' v < 0 with
  *               P v, A_E v - b_E... see ocp_qp_ipm.c (ws->unbounded = 1; no minimiser).
  *   NONFINITE   NaN or Inf in the data (checked before any work) or in the iterates.
  *   MAX_ITER / TIMEOUT  arg->max_iter iterations done / arg->should_stop returned nonzero (polled
