@@ -4,7 +4,9 @@
  *
  * Build: cc -DSOLVER_HEADER='"soak.h"' -DSOLVER_PREFIX=soak_ -I<dir> closed_loop.c <dir>/soak.c
  *        <dir>/soak_model.c -lm
- * Run:   ./closed_loop STEPS SEED DEADLINE_MS
+ * Run:   ./closed_loop STEPS SEED DEADLINE_MS [fixed]
+ * With "fixed", all N_h humans are present at every step and nothing is injected: the workload of
+ * the benchmark's crowds, for instruction counts (valgrind --tool=callgrind; docs/benchmarks.md).
  * Every step: the command is finite; a stop has a reason and no other step has one; whenever the
  * robot is within d_h of a present human a stop is in force; a step without a stop solved its QP.
  * Now and then a NaN is injected into one input (and must give a stop). Prints the counts per stop
@@ -68,7 +70,9 @@ int main(int argc, char **argv)
     long t, counts[N_REASONS] = {0}, violations = 0, injected = 0;
     double x[4] = {0.0, 0.0, 0.0, 0.0}, goal[2][2] = {{12.0, 0.0}, {0.0, 0.0}}, worst_ms = 0.0;
     double closest = 1e9;
-    int k = NH_ALLOC < 5 ? NH_ALLOC : 5, g = 0, j, n;
+    const int fixed = argc > 4 && strcmp(argv[4], "fixed") == 0;
+    int k = fixed || NH_ALLOC < 5 ? NH_ALLOC : 5, g = 0, j, n;
+    long qp_iterations = 0;
     rng_state = (unsigned long long)(argc > 2 ? atol(argv[2]) : 1) * 2654435761ULL + 1ULL;
     if (NH_ALLOC > 64) return 100;
     S(solver_init)(&solver);
@@ -78,7 +82,7 @@ int main(int argc, char **argv)
     for (t = 0; t < steps; t++) {
         double d_goal, d_now = 1e9;
         int inject = 0;
-        if (t % 200 == 199) { /* the crowd changes: another size, some newcomers */
+        if (!fixed && t % 200 == 199) { /* the crowd changes: another size, some newcomers */
             k = (int)uniform(0.0, (double)NH_ALLOC + 0.999);
             for (j = 0; j < NH_ALLOC; j++)
                 if (uniform(0.0, 1.0) < 0.3) spawn(j, x);
@@ -110,7 +114,7 @@ int main(int argc, char **argv)
             in.obstacle[0] = cx + (dn > 1e-9 ? dx / dn : 1.0) * r;
             in.obstacle[1] = cy + (dn > 1e-9 ? dy / dn : 0.0) * r;
         }
-        if (t % 997 == 500) { /* a sensor glitch */
+        if (!fixed && t % 997 == 500) { /* a sensor glitch */
             inject = 1;
             injected++;
             if (k > 0 && uniform(0.0, 1.0) < 0.5)
@@ -143,6 +147,7 @@ int main(int argc, char **argv)
             violations++;
         }
         if (out.stop_reason >= 0 && out.stop_reason < N_REASONS) counts[out.stop_reason]++;
+        qp_iterations += out.qp_iterations;
         if (out.time_total_ms > worst_ms) worst_ms = out.time_total_ms;
         closest = fmin(closest, d_now);
 
@@ -166,6 +171,6 @@ int main(int argc, char **argv)
            steps, violations, injected, worst_ms, closest);
     for (j = 1; j < N_REASONS; j++)
         printf("\"%s\": %ld%s", S(stop_reason_message)(j), counts[j], j + 1 < N_REASONS ? ", " : "");
-    printf("}, \"no_stop\": %ld}\n", counts[0]);
+    printf("}, \"no_stop\": %ld, \"qp_iterations_mean\": %.2f}\n", counts[0], (double)qp_iterations / (double)steps);
     return violations > 100 ? 100 : (int)violations;
 }
