@@ -284,10 +284,12 @@ class SolverStats:
     n_humans: int
     steps: int
     mean_ms: float = float("nan")
+    median_ms: float = float("nan")
     min_ms: float = float("nan")
     max_ms: float = float("nan")
     p99_ms: float = float("nan")
     ratio_to_ours: float = float("nan")
+    median_ratio_to_ours: float = float("nan")  # robust to the odd step a shared machine interrupts
     iterations_mean: float = float("nan")
     iterations_max: int = -1
     failures: int = 0
@@ -305,6 +307,7 @@ def _time_stats(s: SolverStats, times: FloatArray) -> None:
     s.times_ms = [float(v) for v in times]
     if times.size:
         s.mean_ms, s.min_ms, s.max_ms = float(np.mean(times)), float(np.min(times)), float(np.max(times))
+        s.median_ms = float(np.median(times))
         s.p99_ms = float(np.percentile(times, 99))
 
 
@@ -489,6 +492,7 @@ def compare(specs: Sequence[Spec | str | Path], replays: Sequence[Replay | str |
         for g in group:
             if ours is not None and g.error is None and ours.mean_ms > 0:
                 g.ratio_to_ours = g.mean_ms / ours.mean_ms
+                g.median_ratio_to_ours = g.median_ms / ours.median_ms
         rows += group
 
     report: dict[str, Any] = {
@@ -582,19 +586,20 @@ def markdown_section(rows: Sequence[SolverStats], machine: dict[str, str], comma
         "Ipopt found feasible (hard rows are not in the cost). `humanmpc exact+LS`: the same generated solver",
         "with the runtime parameters exact_hessian and line_search on (the behaviour evaluation's RTI).",
         "",
-        "| N_h | solver | mean ms | min ms | max ms | p99 ms | × ours | iterations (mean/max) | failures | RCSO | "
-        "RCSO common (steps) | violation m |",
-        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| N_h | solver | mean ms | median ms | min ms | max ms | p99 ms | × ours (mean) | × ours (median) | "
+        "iterations (mean/max) | failures | RCSO | RCSO common (steps) | violation m |",
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         if r.error is not None:
             lines.append(f"| {r.n_humans} | {r.solver} | not run: {r.error.splitlines()[0][:120]} "
-                         "| | | | | | | | | |")
+                         "| | | | | | | | | | | |")
             continue
         common = f"{_fmt(r.rcso_common, 3)} ({r.rcso_common_steps})" if r.rcso_common_steps else "–"
         lines.append(
-            f"| {r.n_humans} | {r.solver} | {_fmt(r.mean_ms)} | {_fmt(r.min_ms)} | {_fmt(r.max_ms)} | "
-            f"{_fmt(r.p99_ms)} | {_fmt(r.ratio_to_ours, 2)} | {_fmt(r.iterations_mean, 3)}/{r.iterations_max} | "
+            f"| {r.n_humans} | {r.solver} | {_fmt(r.mean_ms)} | {_fmt(r.median_ms)} | {_fmt(r.min_ms)} | "
+            f"{_fmt(r.max_ms)} | {_fmt(r.p99_ms)} | {_fmt(r.ratio_to_ours, 2)} | {_fmt(r.median_ratio_to_ours, 2)} | "
+            f"{_fmt(r.iterations_mean, 3)}/{r.iterations_max} | "
             f"{r.failures}/{r.steps} | {_fmt(r.rcso, 3)} | {common} | {_fmt(r.max_violation_m, 3)} |"
         )
     lines += [

@@ -40,6 +40,8 @@ def test_compare_writes_table_plot_and_json(tmp_path: Path) -> None:
         assert ours["error"] is None, ours["error"]
         assert ours["ratio_to_ours"] == pytest.approx(1.0)
         assert cold["ratio_to_ours"] == pytest.approx(cold["mean_ms"] / ours["mean_ms"])
+        assert cold["median_ratio_to_ours"] == pytest.approx(cold["median_ms"] / ours["median_ms"])
+        assert cold["min_ms"] <= cold["median_ms"] <= cold["max_ms"]
         assert np.isfinite(ours["rcso"]) and ours["rcso_steps"] == 6
         exact = by[(n, "humanmpc exact+LS")]
         assert exact["error"] is None and exact["rcso_steps"] == 6
@@ -75,12 +77,14 @@ def test_compare_refuses_mismatched_inputs(tmp_path: Path) -> None:
 
 
 def test_markdown_reports_solvers_that_did_not_run() -> None:
-    rows = [SolverStats("humanmpc", 5, 10, mean_ms=0.5, min_ms=0.4, max_ms=0.7, p99_ms=0.69, ratio_to_ours=1.0,
+    rows = [SolverStats("humanmpc", 5, 10, mean_ms=0.5, median_ms=0.45, min_ms=0.4, max_ms=0.7, p99_ms=0.69,
+                        ratio_to_ours=1.0, median_ratio_to_ours=1.0,
                         iterations_mean=12.0, iterations_max=20, failures=1, rcso=0.01, rcso_steps=10,
                         max_violation_m=0.0),
             SolverStats("acados default", 5, 10, error="acados needs Python 3.12 ...")]
     md = markdown_section(rows, {"cpu": "x"}, "cmd")
-    assert "| 5 | humanmpc | 0.500 | 0.400 | 0.700 | 0.690 | 1.00 | 12.000/20 | 1/10 | 0.010 | – | 0.000 |" in md
+    assert ("| 5 | humanmpc | 0.500 | 0.450 | 0.400 | 0.700 | 0.690 | 1.00 | 1.00 | 12.000/20 | 1/10 | 0.010 | – "
+            "| 0.000 |") in md
     assert "| 5 | acados default | not run: acados needs Python 3.12" in md
 
 
