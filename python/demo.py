@@ -66,7 +66,8 @@ def run_demo(seed: int = 0, out_dir: Path = Path("out/demo")) -> Path:
         logs[name] = run_episode(scenario, planner)
     rows = {name: compute_metrics(log).as_row() for name, log in logs.items()}
     print(f"\n{SCENARIO}, seed {seed}: HuMAN-MPC (generated C, SQP-RTI) vs the DWB baseline")
-    print("mpc: the evaluation's configuration (global-path carrot, exact-Hessian RTI, q = 50, ...); "
+    print("mpc: the evaluation's configuration (global-path carrot, loop restart, exact-Hessian RTI, "
+          "q = 50, w_v = 50, ...); "
           "mpc_paper: the paper's parameters and the final goal (docs/evaluation.md)\n")
     print(side_by_side(rows))
     print()

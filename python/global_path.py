@@ -159,8 +159,9 @@ def local_segment(path: FloatArray, position: ArrayLike, lookahead: float) -> Fl
 class GlobalPlanner:
     """The global planner every local planner of the evaluation shares (nav2's planner server feeding
     its controller): an A* path from the robot to the goal, replanned every ``replan_period`` seconds
-    and whenever the goal changes, with the humans' current positions as obstacles (nav2's default
-    behaviour tree replans at 1 Hz on a costmap whose obstacle layer sees the people)."""
+    and whenever the goal changes, with the humans' current positions as obstacles when they are given
+    (the DWB gives them: nav2's default behaviour tree replans at 1 Hz on a costmap whose obstacle layer
+    sees the people; the MPC does not: its OCP has their predictions)."""
 
     def __init__(self, grid: GridConfig | None = None, replan_period: float = 1.0) -> None:
         if not replan_period > 0:
