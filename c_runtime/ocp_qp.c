@@ -218,3 +218,29 @@ HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, h
     }
     res->obj = obj;
 }
+
+HM_FUNC hm_real ocp_qp_res_worst(const hm_ocp_qp_res *res)
+{
+    hm_real a = res->stat > res->eq ? res->stat : res->eq;
+    a = a > res->ineq ? a : res->ineq;
+    a = a > res->comp ? a : res->comp;
+    return a > res->dual ? a : res->dual;
+}
+
+HM_FUNC void ocp_qp_sol_box_certificate(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, int bad)
+{
+    const int n = bad / (HM_NU + HM_NX);
+    const int c = bad % (HM_NU + HM_NX);
+    int i;
+    ocp_qp_sol_set_zero(sol);
+    for (i = 0; i < HM_NX; i++) sol->x[0][i] = qp->x0[i];
+    if (c < HM_NU) {
+        const hm_real lam = HM_R(1.0) / (qp->lbu[n][c] - qp->ubu[n][c]);
+        sol->lam_lbu[n][c] = lam;
+        sol->lam_ubu[n][c] = lam;
+    } else {
+        const hm_real lam = HM_R(1.0) / (qp->lbx[n][c - HM_NU] - qp->ubx[n][c - HM_NU]);
+        sol->lam_lbx[n][c - HM_NU] = lam;
+        sol->lam_ubx[n][c - HM_NU] = lam;
+    }
+}

@@ -36,4 +36,11 @@ HM_FUNC int ocp_qp_bound_present(hm_real bound);
 /* Residuals of the KKT conditions of (qp, sol) in the conventions above (hm_types.h: ocp_qp_res). */
 HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, hm_ocp_qp_res *res);
 
+/* The worst of the residuals, the measure by which a polished solution must improve. */
+HM_FUNC hm_real ocp_qp_res_worst(const hm_ocp_qp_res *res);
+
+/* sol := the certificate of the crossing bounds lb > ub of component bad (stage * (HM_NU + HM_NX) +
+ * component of (u, x)): lam_lb = lam_ub = 1 / (lb - ub), everything else zero, x_0 = qp->x0. */
+HM_FUNC void ocp_qp_sol_box_certificate(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, int bad);
+
 #endif /* OCP_QP_H */

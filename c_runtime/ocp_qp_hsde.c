@@ -75,25 +75,6 @@ HM_FUNC void ocp_qp_hsde_kkt_stage_matrix(const hm_ocp_qp *restrict qp, hm_ocp_q
     for (k = 0; k < nb; k++) H[ws->box_comp[n][k] * (HM_QP_NUX + 1)] += w[off + k];
 }
 
-/* F = P M for the symmetric 4x4 P and the 4 x ncol matrix M, column by column in axpy form. */
-HM_FUNC void ocp_qp_hsde_kkt_mul_sym(const hm_real *restrict P, const hm_real *restrict M, hm_real *restrict F, int ncol)
-{
-    int i, j, k;
-    for (j = 0; j < ncol; j++) {
-        hm_real f[HM_NX] = {HM_R(0.0), HM_R(0.0), HM_R(0.0), HM_R(0.0)};
-        for (k = 0; k < HM_NX; k++) {
-            const hm_real mk = M[k + j * HM_NX];
-            for (i = 0; i < HM_NX; i++) f[i] += P[i + k * HM_NX] * mk;
-        }
-        for (i = 0; i < HM_NX; i++) F[i + j * HM_NX] = f[i];
-    }
-}
-
-HM_FUNC hm_real ocp_qp_hsde_kkt_dot4(const hm_real *restrict a, const hm_real *restrict b)
-{
-    return (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
-}
-
 HM_FUNC int ocp_qp_hsde_kkt_factorize(const hm_ocp_qp *restrict qp, hm_ocp_qp_hsde_ws *restrict ws)
 {
     hm_real H[HM_QP_NUX * HM_QP_NUX];
@@ -117,20 +98,20 @@ HM_FUNC int ocp_qp_hsde_kkt_factorize(const hm_ocp_qp *restrict qp, hm_ocp_qp_hs
         hm_real l00, l10, piv;
 
         ocp_qp_hsde_kkt_stage_matrix(qp, ws, n, H);
-        ocp_qp_hsde_kkt_mul_sym(Pn, B, FB, HM_NU);
+        ocp_qp_kkt_mul4(Pn, B, FB, HM_NU);
         for (j = 0; j < HM_NU; j++) {
-            for (i = j; i < HM_NU; i++) H[i + j * HM_QP_NUX] += ocp_qp_hsde_kkt_dot4(&B[i * HM_NX], &FB[j * HM_NX]);
+            for (i = j; i < HM_NU; i++) H[i + j * HM_QP_NUX] += ocp_qp_kkt_dot4(&B[i * HM_NX], &FB[j * HM_NX]);
         }
         if (n > 0) {
             hm_real FA[HM_NX * HM_NX];   /* P_{n+1} A */
-            ocp_qp_hsde_kkt_mul_sym(Pn, A, FA, HM_NX);
+            ocp_qp_kkt_mul4(Pn, A, FA, HM_NX);
             for (j = 0; j < HM_NU; j++) {
                 for (i = 0; i < HM_NX; i++)
-                    H[HM_NU + i + j * HM_QP_NUX] += ocp_qp_hsde_kkt_dot4(&A[i * HM_NX], &FB[j * HM_NX]);
+                    H[HM_NU + i + j * HM_QP_NUX] += ocp_qp_kkt_dot4(&A[i * HM_NX], &FB[j * HM_NX]);
             }
             for (j = 0; j < HM_NX; j++) {
                 for (i = j; i < HM_NX; i++)
-                    H[HM_NU + i + (HM_NU + j) * HM_QP_NUX] += ocp_qp_hsde_kkt_dot4(&A[i * HM_NX], &FA[j * HM_NX]);
+                    H[HM_NU + i + (HM_NU + j) * HM_QP_NUX] += ocp_qp_kkt_dot4(&A[i * HM_NX], &FA[j * HM_NX]);
             }
         }
 
@@ -858,26 +839,6 @@ HM_FUNC void ocp_qp_hsde_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_hsde_ws 
     }
 }
 
-/* Certificate of crossing bounds lb > ub on component bad (stage * HM_QP_NUX + component):
- * lam_lb = lam_ub = 1 / (lb - ub). */
-HM_FUNC void ocp_qp_hsde_write_box_certificate(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, int bad)
-{
-    const int n = bad / HM_QP_NUX;
-    const int c = bad % HM_QP_NUX;
-    int i;
-    ocp_qp_sol_set_zero(sol);
-    for (i = 0; i < HM_NX; i++) sol->x[0][i] = qp->x0[i];
-    if (c < HM_NU) {
-        const hm_real lam = HM_R(1.0) / (qp->lbu[n][c] - qp->ubu[n][c]);
-        sol->lam_lbu[n][c] = lam;
-        sol->lam_ubu[n][c] = lam;
-    } else {
-        const hm_real lam = HM_R(1.0) / (qp->lbx[n][c - HM_NU] - qp->ubx[n][c - HM_NU]);
-        sol->lam_lbx[n][c - HM_NU] = lam;
-        sol->lam_ubx[n][c - HM_NU] = lam;
-    }
-}
-
 /* Starting point (Clarabel's for QPs): (v, w) solving the Newton system with unit row weights for
  * the right-hand side (-q, b), i.e. the minimiser of the cost plus 1/2 ||A_I v - b_I||^2 under the
  * dynamics; then t = b_I - A_I v and z, each shifted into the interior; tau = kappa = 1. */
@@ -894,15 +855,6 @@ HM_FUNC int ocp_qp_hsde_init(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws)
     ws->tau = HM_R(1.0);
     ws->kappa = HM_R(1.0);
     return 0;
-}
-
-/* The worst of the residuals of a solution, the measure by which a polished solution must improve. */
-HM_FUNC hm_real ocp_qp_hsde_res_worst(const hm_ocp_qp_res *res)
-{
-    hm_real a = OCP_QP_HSDE_MAX(res->stat, res->eq);
-    a = OCP_QP_HSDE_MAX(a, res->ineq);
-    a = OCP_QP_HSDE_MAX(a, res->comp);
-    return OCP_QP_HSDE_MAX(a, res->dual);
 }
 
 /* Active-set polish (after OSQP's): rows whose slack is smaller than their multiplier are taken as
@@ -923,7 +875,7 @@ HM_FUNC void ocp_qp_hsde_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
     /* dropped rows keep a weight far below rounding level, not zero: a soft row's slack may have
      * neither curvature nor an active bound, and its elimination divides by the sum of the three */
     const hm_real w_drop = HM_EPS * HM_EPS / ws->w_max;
-    const hm_real before = ocp_qp_hsde_res_worst(&ws->res);
+    const hm_real before = ocp_qp_res_worst(&ws->res);
     hm_ocp_qp_res res;
     ocp_qp_hsde_sums sm;
     int j, k, n, i, round, dropped = 1;
@@ -967,7 +919,7 @@ HM_FUNC void ocp_qp_hsde_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
     }
     ocp_qp_hsde_write_sol(qp, ws, d, sol, HM_R(1.0) / ws->cost_scale, HM_R(1.0));
     ocp_qp_res_compute(qp, sol, &res);
-    if (ocp_qp_hsde_res_worst(&res) < before) {
+    if (ocp_qp_res_worst(&res) < before) {
         ws->res = res;
         ws->polished = 1;
     } else {
@@ -1010,7 +962,7 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
     if (status) return ocp_qp_hsde_finish(qp, sol, ws, status, HM_R(0.0), 0, 0);
     status = ocp_qp_hsde_setup(qp, ws, &bad);
     if (status == HM_QP_INFEASIBLE) {
-        ocp_qp_hsde_write_box_certificate(qp, sol, bad);
+        ocp_qp_sol_box_certificate(qp, sol, bad);
         ocp_qp_res_compute(qp, sol, &ws->res);
         ws->status = status;
         return status;

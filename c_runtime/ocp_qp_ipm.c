@@ -981,26 +981,6 @@ HM_FUNC void ocp_qp_ipm_write_sol_vec(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_w
     }
 }
 
-/* Certificate of crossing bounds lb > ub on component bad (stage * HM_QP_NUX + component):
- * lam_lb = lam_ub = 1 / (lb - ub). */
-HM_FUNC void ocp_qp_ipm_write_box_certificate(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, int bad)
-{
-    const int n = bad / HM_QP_NUX;
-    const int c = bad % HM_QP_NUX;
-    int i;
-    ocp_qp_sol_set_zero(sol);
-    for (i = 0; i < HM_NX; i++) sol->x[0][i] = qp->x0[i];
-    if (c < HM_NU) {
-        const hm_real lam = HM_R(1.0) / (qp->lbu[n][c] - qp->ubu[n][c]);
-        sol->lam_lbu[n][c] = lam;
-        sol->lam_ubu[n][c] = lam;
-    } else {
-        const hm_real lam = HM_R(1.0) / (qp->lbx[n][c - HM_NU] - qp->ubx[n][c - HM_NU]);
-        sol->lam_lbx[n][c - HM_NU] = lam;
-        sol->lam_ubx[n][c - HM_NU] = lam;
-    }
-}
-
 /* Farkas test of the dual part w = (y, z) of a vector in the solver's layout: b' w < 0 and
  * ||A' w||_inf <= tol_infeas * (-b' w) (z >= 0 is the caller's). Returns 1 if it passes, with b' w. */
 HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_vec *w,
@@ -1123,15 +1103,6 @@ HM_FUNC void ocp_qp_ipm_ray_from_step(hm_ocp_qp_ipm_ws *ws)
 /* ------------------------------------------------------------------------------------------------
  * Active-set polish
  * ---------------------------------------------------------------------------------------------- */
-
-/* The worst of the residuals of a solution, the measure by which a polished solution must improve. */
-HM_FUNC hm_real ocp_qp_ipm_res_worst(const hm_ocp_qp_res *res)
-{
-    hm_real a = OCP_QP_IPM_MAX(res->stat, res->eq);
-    a = OCP_QP_IPM_MAX(a, res->ineq);
-    a = OCP_QP_IPM_MAX(a, res->comp);
-    return OCP_QP_IPM_MAX(a, res->dual);
-}
 
 /* Residual of the Newton system with the polish's weights at (d, dz), as rhs - K d, written as
  * e = -(K d - rhs) for the constant right-hand side (-q, b): e.ux = -(P v + q + A' w),
@@ -1312,7 +1283,7 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
     /* dropped inequalities keep a weight far below rounding level, not zero: a soft row's slack may
      * have neither curvature nor an active bound, and its elimination divides by the sum of three */
     const hm_real w_drop = HM_EPS * HM_EPS / wmax;
-    const hm_real before = ocp_qp_ipm_res_worst(&ws->res);
+    const hm_real before = ocp_qp_res_worst(&ws->res);
     hm_ocp_qp_res res;
     int n, i, k, j, l, round, changed = 1;
 
@@ -1390,9 +1361,9 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
     ocp_qp_res_compute(qp, sol, &res);
 #ifdef OCP_QP_IPM_TRACE
     printf("polish: before %.3e after %.3e (stat %.2e eq %.2e ineq %.2e comp %.2e dual %.2e)\n", (double)before,
-           (double)ocp_qp_ipm_res_worst(&res), (double)res.stat, (double)res.eq, (double)res.ineq, (double)res.comp, (double)res.dual);
+           (double)ocp_qp_res_worst(&res), (double)res.stat, (double)res.eq, (double)res.ineq, (double)res.comp, (double)res.dual);
 #endif
-    if (ocp_qp_ipm_res_worst(&res) < before) {
+    if (ocp_qp_res_worst(&res) < before) {
         ws->res = res;
         ws->polished = 1;
     } else {
@@ -1469,7 +1440,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
     if (status) return ocp_qp_ipm_finish(qp, sol, ws, status, HM_R(0.0), 0, 0, 1, HM_R(0.0));
     status = ocp_qp_ipm_setup(qp, ws, &bad);
     if (status == HM_QP_INFEASIBLE) {
-        ocp_qp_ipm_write_box_certificate(qp, sol, bad);
+        ocp_qp_sol_box_certificate(qp, sol, bad);
         ocp_qp_res_compute(qp, sol, &ws->res);
         ws->status = status;
         return status;

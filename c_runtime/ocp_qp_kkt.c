@@ -46,6 +46,23 @@ HM_FUNC void ocp_qp_kkt_mv4(const hm_real *restrict P, const hm_real *restrict x
     }
 }
 
+/* LDL' of the 2x2 input block [h00 h10; h10 h11] into sn->Ld (1 / d0, l10, 1 / d1); HM_QP_NUMERICAL
+ * if a pivot is not safely positive: the QP is not strictly convex in u along the current active set
+ * (`!(a > b)` also catches NaN). */
+HM_FUNC int ocp_qp_kkt_input_ldl(hm_ocp_qp_ipm_stage *restrict sn, hm_real h00, hm_real h10, hm_real h11)
+{
+    hm_real id0, l10, d1;
+    if (!(h00 > HM_R(0.0))) return HM_QP_NUMERICAL;
+    id0 = HM_R(1.0) / h00;
+    l10 = h10 * id0;
+    d1 = h11 - l10 * h10;
+    if (!(d1 > HM_R(64.0) * HM_EPS * h11) || !(d1 > HM_R(0.0))) return HM_QP_NUMERICAL;
+    sn->Ld[0] = id0;
+    sn->Ld[1] = l10;
+    sn->Ld[2] = HM_R(1.0) / d1;
+    return 0;
+}
+
 /* Stage 0 < n < HM_N of the factorisation when A_n = [e_0 e_1 a_2 a_3] (the robot's dynamics: the
  * position enters no other state's update), written out: every matrix entry a scalar, the
  * symmetric ones once. Same results as the general path up to the order of the sums. */
@@ -92,7 +109,7 @@ HM_FUNC int ocp_qp_kkt_factor_stage_posfree(const hm_ocp_qp *restrict qp, hm_ocp
     const hm_real x01 = S[1] + f01, x11 = S[3] + f11;
     const hm_real x21 = S[5] + (a02 * f01 + a12 * f11 + a22 * f21 + a32 * f31);
     const hm_real x31 = S[7] + (a03 * f01 + a13 * f11 + a23 * f21 + a33 * f31);
-    hm_real id0, l10, d1, id1, k0[4], k1[4], c0[4], c1[4], *restrict Pn = sn->P;
+    hm_real id0, l10, id1, k0[4], k1[4], c0[4], c1[4], *restrict Pn = sn->P;
     hm_real q00, q10, q20, q30, q11, q21, q31, q22, q32, q33;
     {
         const hm_real *restrict r = sn->ry;
@@ -102,15 +119,10 @@ HM_FUNC int ocp_qp_kkt_factor_stage_posfree(const hm_ocp_qp *restrict qp, hm_ocp
         pr[2] = p20 * r[0] + p21 * r[1] + p22 * r[2] + p32 * r[3];
         pr[3] = p30 * r[0] + p31 * r[1] + p32 * r[2] + p33 * r[3];
     }
-    if (!(h00 > HM_R(0.0))) return HM_QP_NUMERICAL;
-    id0 = HM_R(1.0) / h00;
-    l10 = h10 * id0;
-    d1 = h11 - l10 * h10;
-    if (!(d1 > HM_R(64.0) * HM_EPS * h11) || !(d1 > HM_R(0.0))) return HM_QP_NUMERICAL;
-    id1 = HM_R(1.0) / d1;
-    sn->Ld[0] = id0;
-    sn->Ld[1] = l10;
-    sn->Ld[2] = id1;
+    if (ocp_qp_kkt_input_ldl(sn, h00, h10, h11)) return HM_QP_NUMERICAL;
+    id0 = sn->Ld[0];
+    l10 = sn->Ld[1];
+    id1 = sn->Ld[2];
     k0[0] = x00;
     k0[1] = x10;
     k0[2] = x20;
@@ -234,19 +246,10 @@ HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_
         }
     }
 
-    /* partial LDL' over the u rows; a pivot that is not safely positive means the QP is not strictly
-     * convex in u along the current active set (`!(a > b)` also catches NaN) */
+    /* partial LDL' over the u rows */
+    if (ocp_qp_kkt_input_ldl(sn, h00, h10, h11)) return HM_QP_NUMERICAL;
     {
-        hm_real id0, l10, d1, id1;
-        if (!(h00 > HM_R(0.0))) return HM_QP_NUMERICAL;
-        id0 = HM_R(1.0) / h00;
-        l10 = h10 * id0;
-        d1 = h11 - l10 * h10;
-        if (!(d1 > HM_R(64.0) * HM_EPS * h11) || !(d1 > HM_R(0.0))) return HM_QP_NUMERICAL;
-        id1 = HM_R(1.0) / d1;
-        sn->Ld[0] = id0;
-        sn->Ld[1] = l10;
-        sn->Ld[2] = id1;
+        const hm_real id0 = sn->Ld[0], l10 = sn->Ld[1], id1 = sn->Ld[2];
         if (n == 0) return 0;
         {
             hm_real *restrict K0 = sn->Kx;
