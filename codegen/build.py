@@ -62,6 +62,13 @@ def host_cflags(compiler: str) -> str:
     return HOST_CFLAGS if _host_flags_ok[compiler] else PORTABLE_CFLAGS
 
 
+def compiler_and_flags(env: dict[str, str] | None = None) -> tuple[str, str]:
+    """The C compiler and flags a build uses: $CC (default cc) and $CFLAGS, else ``host_cflags``."""
+    e = os.environ if env is None else env
+    compiler = e.get("CC", "cc")
+    return compiler, e.get("CFLAGS") or host_cflags(compiler)
+
+
 def build(solver_dir: str | Path, *, cc: str | None = None, cflags: str | None = None,
           log: Callable[[str], None] | None = None) -> Path:
     """Run the package's Makefile; return the path of the shared library.
@@ -81,8 +88,7 @@ def build(solver_dir: str | Path, *, cc: str | None = None, cflags: str | None =
     compiler = env.get("CC", "cc")
     if shutil.which(compiler.split()[0]) is None:
         raise BuildError(f"C compiler {compiler!r} was not found on PATH (set CC or install gcc)")
-    if not env.get("CFLAGS"):
-        env["CFLAGS"] = host_cflags(compiler)
+    compiler, env["CFLAGS"] = compiler_and_flags(env)
     say(f"[humanmpc] building {d.name} with {compiler} ({env['CFLAGS']})")
     proc = subprocess.run([make, "-C", str(d), "--no-print-directory", "all"], env=env,
                           capture_output=True, text=True, check=False)

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from humanmpc.codegen.build import build, host_cflags
+from humanmpc.codegen.build import build, compiler_and_flags
 from humanmpc.codegen.generate import generate
 from humanmpc.codegen.spec import Spec, resolve_spec
 
@@ -231,8 +231,7 @@ def run_bench(base: Spec, humans: Sequence[int], *, seeds: int = 3, steps: int =
             f"p99 {res.python_ms.p99:.3f} ms, QP solved {100 * res.solved_fraction:.1f}%")
         results.append(res)
     out_dir.mkdir(parents=True, exist_ok=True)
-    compiler = os.environ.get("CC", "cc")
-    cflags = os.environ.get("CFLAGS") or host_cflags(compiler)
+    compiler, cflags = compiler_and_flags()
     payload = {"machine": machine_description(), "compiler": f"{compiler} {cflags}", "spec_base": base.to_dict(),
                "results": [asdict(r) for r in results]}
     (out_dir / "bench.json").write_text(json.dumps(payload, indent=2) + "\n")

@@ -36,12 +36,9 @@ QP_STATUS_NAMES = {
 }
 
 
-def _int_field(key: str) -> property:
-    return property(lambda self: int(self._rec[key]), doc=f"the output's {key}")
-
-
-def _real_field(key: str) -> property:
-    return property(lambda self: float(self._rec[key]), doc=f"the output's {key}")
+def _field(key: str, convert: type) -> property:
+    """A scalar field of the output record, as a Python int or float."""
+    return property(lambda self: convert(self._rec[key]), doc=f"the output's {key}")
 
 
 class StepResult:
@@ -88,21 +85,21 @@ class StepResult:
     def u(self) -> FloatArray:
         return self._array("u")
 
-    stop_reason = _int_field("stop_reason")
-    status = _int_field("status")
-    qp_status = _int_field("qp_status")
-    qp_iterations = _int_field("qp_iterations")
-    sqp_iterations = _int_field("sqp_iterations")
-    qp_solves = _int_field("qp_solves")
-    cost = _real_field("cost")
-    kkt_stat = _real_field("kkt_stat")
-    kkt_eq = _real_field("kkt_eq")
-    kkt_ineq = _real_field("kkt_ineq")
-    kkt_comp = _real_field("kkt_comp")
-    min_human_distance = _real_field("min_human_distance")
-    time_prepare_ms = _real_field("time_prepare_ms")
-    time_feedback_ms = _real_field("time_feedback_ms")
-    time_total_ms = _real_field("time_total_ms")
+    stop_reason = _field("stop_reason", int)
+    status = _field("status", int)
+    qp_status = _field("qp_status", int)
+    qp_iterations = _field("qp_iterations", int)
+    sqp_iterations = _field("sqp_iterations", int)
+    qp_solves = _field("qp_solves", int)
+    cost = _field("cost", float)
+    kkt_stat = _field("kkt_stat", float)
+    kkt_eq = _field("kkt_eq", float)
+    kkt_ineq = _field("kkt_ineq", float)
+    kkt_comp = _field("kkt_comp", float)
+    min_human_distance = _field("min_human_distance", float)
+    time_prepare_ms = _field("time_prepare_ms", float)
+    time_feedback_ms = _field("time_feedback_ms", float)
+    time_total_ms = _field("time_total_ms", float)
 
     def __repr__(self) -> str:
         return (f"StepResult(stop={self.stop}, reason={self.reason}, status={self.status_name}, "
