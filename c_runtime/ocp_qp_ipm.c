@@ -51,6 +51,35 @@
 #define OCP_QP_IPM_MIN(a, b) ((a) < (b) ? (a) : (b))
 #define OCP_QP_IPM_ABS(a) ((a) < HM_R(0.0) ? -(a) : (a))
 
+/* Profiling builds only (-DOCP_QP_IPM_PROFILE; docs/pass_profile.sh): the time of each part of the
+ * solves accumulates in ocp_qp_ipm_profile_ns[part], read with the including program's clock
+ * ocp_qp_ipm_profile_clock_ns(). The counters are the program's, shared by every solver in it. */
+enum {
+    OCP_QP_IPM_PROF_SETUP,     /* data check, stage blocks and starting point */
+    OCP_QP_IPM_PROF_A,
+    OCP_QP_IPM_PROF_B,
+    OCP_QP_IPM_PROF_C,
+    OCP_QP_IPM_PROF_D,
+    OCP_QP_IPM_PROF_E,
+    OCP_QP_IPM_PROF_FINISH,    /* solution, residuals, polish, and the fallback solver when it runs */
+    OCP_QP_IPM_PROF_PARTS
+};
+#ifdef OCP_QP_IPM_PROFILE
+extern double ocp_qp_ipm_profile_ns[OCP_QP_IPM_PROF_PARTS];
+extern double ocp_qp_ipm_profile_clock_ns(void);
+#define OCP_QP_IPM_PROF(part, stmt)                                                    \
+    do {                                                                               \
+        const double prof_t0_ = ocp_qp_ipm_profile_clock_ns();                         \
+        stmt;                                                                          \
+        ocp_qp_ipm_profile_ns[part] += ocp_qp_ipm_profile_clock_ns() - prof_t0_;       \
+    } while (0)
+#else
+#define OCP_QP_IPM_PROF(part, stmt) \
+    do {                            \
+        stmt;                       \
+    } while (0)
+#endif
+
 HM_FUNC void ocp_qp_ipm_arg_set_default(hm_ocp_qp_ipm_arg *arg)
 {
     arg->max_iter = 50;
@@ -1425,7 +1454,7 @@ HM_FUNC int ocp_qp_ipm_fallback(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
 HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws,
                              const hm_ocp_qp_ipm_arg *arg)
 {
-    int status, bad = 0, ray = 0, fallback = 0;
+    int status, bad = 0, ray = 0, fallback = 0, singular;
     ocp_qp_ipm_sums sm;
     hm_real mu0 = HM_R(1.0), alpha = HM_R(0.0), alpha_prev = HM_R(1.0), rp0 = HM_R(0.0);
     hm_real mu_hist[OCP_QP_IPM_STALL_ITERS] = {HM_R(0.0)};
@@ -1436,9 +1465,9 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
     ws->fallback = 0;
     ws->res_primal = ws->res_dual = ws->gap = ws->mu = HM_R(0.0);
 
-    status = ocp_qp_check(qp);
+    OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_SETUP, status = ocp_qp_check(qp));
     if (status) return ocp_qp_ipm_finish(qp, sol, ws, status, HM_R(0.0), 0, 0, 1, HM_R(0.0));
-    status = ocp_qp_ipm_setup(qp, ws, &bad);
+    OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_SETUP, status = ocp_qp_ipm_setup(qp, ws, &bad));
     if (status == HM_QP_INFEASIBLE) {
         ocp_qp_sol_box_certificate(qp, sol, bad);
         ocp_qp_res_compute(qp, sol, &ws->res);
@@ -1452,7 +1481,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         hm_real mu, res_p, res_d, pcost, gap, gap_rel, sigma, smu, alpha_aff, mu_aff, frac, ratio;
         ocp_qp_ipm_pred pr;
 
-        ocp_qp_ipm_pass_a(qp, ws, alpha, &sm);
+        OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_A, ocp_qp_ipm_pass_a(qp, ws, alpha, &sm));
         mu = sm.tz / mdeg;
         if (ws->iter == 0) {
             mu0 = mu;
@@ -1564,14 +1593,15 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         alpha_prev = alpha;
 
         /* predictor */
-        if (ocp_qp_ipm_pass_b(qp, ws)) {
+        OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_B, singular = ocp_qp_ipm_pass_b(qp, ws));
+        if (singular) {
             /* singular at the start: the QP is not strictly convex in u; later: the weights of a
              * diverging iteration */
             if (ws->iter > 1) fallback = 1;
             status = HM_QP_NUMERICAL;
             break;
         }
-        ocp_qp_ipm_pass_c(qp, ws, &pr);
+        OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_C, ocp_qp_ipm_pass_c(qp, ws, &pr));
         alpha_aff = HM_R(1.0) / OCP_QP_IPM_MAX(HM_R(1.0), pr.ratio);
         mu_aff = (sm.tz + alpha_aff * (pr.tdz + alpha_aff * pr.dtdz)) / mdeg;
         sigma = mu > HM_R(0.0) ? mu_aff / mu : HM_R(0.0);
@@ -1580,14 +1610,14 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         smu = sigma * mu;
 
         /* corrector */
-        ocp_qp_ipm_pass_d(qp, ws, smu, HM_R(1.0));
-        ratio = ocp_qp_ipm_pass_e(qp, ws, smu, HM_R(1.0));
+        OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_D, ocp_qp_ipm_pass_d(qp, ws, smu, HM_R(1.0)));
+        OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_E, ratio = ocp_qp_ipm_pass_e(qp, ws, smu, HM_R(1.0)));
         if (ratio > HM_R(10.0)) {
             /* a step below 0.1: the iterate is too far off the central path for Mehrotra's
              * second-order term; solve again for a centring step without it (one more solve, rare) */
             smu = OCP_QP_IPM_MAX(sigma, HM_R(0.5)) * mu;
-            ocp_qp_ipm_pass_d(qp, ws, smu, HM_R(0.0));
-            ratio = ocp_qp_ipm_pass_e(qp, ws, smu, HM_R(0.0));
+            OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_D, ocp_qp_ipm_pass_d(qp, ws, smu, HM_R(0.0)));
+            OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_E, ratio = ocp_qp_ipm_pass_e(qp, ws, smu, HM_R(0.0)));
         }
 
         /* fraction to the boundary: arg->step_frac far from the solution, closer to 1 as mu falls
@@ -1624,12 +1654,17 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
             break;
         }
     }
-    if (fallback) return ocp_qp_ipm_fallback(qp, sol, ws, arg);
+    if (fallback) {
+        OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_FINISH, status = ocp_qp_ipm_fallback(qp, sol, ws, arg));
+        return status;
+    }
     if (ray) {
         ocp_qp_ipm_write_sol_vec(qp, ws, &ws->u.f.va, sol, HM_R(1.0) / -sm.bw);
         ocp_qp_res_compute(qp, sol, &ws->res);
         ws->status = status;
         return status;
     }
-    return ocp_qp_ipm_finish(qp, sol, ws, status, sm.bw, 1, arg->polish, arg->residuals, alpha);
+    OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_FINISH,
+                    status = ocp_qp_ipm_finish(qp, sol, ws, status, sm.bw, 1, arg->polish, arg->residuals, alpha));
+    return status;
 }

@@ -66,6 +66,18 @@ def test_soak_of_100000_rti_steps_in_a_changing_crowd(soak_dir: Path, tmp_path: 
     (tmp_path / "soak.json").write_text(json.dumps(summary))
 
 
+def test_profile_build_times_every_qp_part_and_the_parts_fit_in_the_step(soak_dir: Path, tmp_path: Path) -> None:
+    """-DOCP_QP_IPM_PROFILE (docs/pass_profile.sh) builds strictly and accounts for time inside the step only."""
+    exe = build_closed_loop(soak_dir, tmp_path / "loop_prof", "gcc",
+                            ["-O2", "-D_POSIX_C_SOURCE=199309L", "-DOCP_QP_IPM_PROFILE"])
+    summary = run_closed_loop([str(exe), "300", "5", "1e4", "fixed"], timeout=300)
+    qp_parts = ["qp_setup", "qp_pass_a", "qp_pass_b", "qp_pass_c", "qp_pass_d", "qp_pass_e", "qp_finish"]
+    timed = {p: summary[p + "_us"] for p in qp_parts}
+    assert all(t > 0.0 for t in timed.values()), timed
+    # nested in the step's own timer: together with the preparation they cannot exceed it
+    assert sum(timed.values()) + summary["prepare_us"] <= 1.02 * summary["step_us"] + 1.0, summary
+
+
 def test_libfuzzer_over_the_step_function_finds_nothing(tmp_path: Path) -> None:
     clang = require_tool("clang")
     d = make_solver(tmp_path, {"name": "fuzz", "horizon": {"N": 12, "T": 1.2}, "humans": {"max": 4}})

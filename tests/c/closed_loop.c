@@ -11,6 +11,9 @@
  * robot is within d_h of a present human a stop is in force; a step without a stop solved its QP.
  * Now and then a NaN is injected into one input (and must give a stop). Prints the counts per stop
  * reason; the exit status is the number of violated invariants (capped), 0 when none.
+ * Built with -DOCP_QP_IPM_PROFILE (and _POSIX_C_SOURCE for the clock), it also prints where the
+ * steps' time went: the solver's preparation and step timers, and the QP solver's parts
+ * (ocp_qp_ipm.c), in microseconds per step (docs/pass_profile.sh).
  */
 #include <math.h>
 #include <stdio.h>
@@ -27,6 +30,19 @@
 #define NNODES ((int)(sizeof(((S(output) *)0)->x) / sizeof(((S(output) *)0)->x[0])))
 #define DT 0.1
 #define N_REASONS 8
+
+#ifdef OCP_QP_IPM_PROFILE
+#include <time.h>
+double ocp_qp_ipm_profile_ns[7];
+double ocp_qp_ipm_profile_clock_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
+}
+static const char *const profile_parts[7] = {"qp_setup", "qp_pass_a", "qp_pass_b", "qp_pass_c", "qp_pass_d",
+                                             "qp_pass_e", "qp_finish"};
+#endif
 
 static S(solver) solver; /* all memory of the solver, placed statically */
 static S(input) in;
@@ -73,6 +89,7 @@ int main(int argc, char **argv)
     const int fixed = argc > 4 && strcmp(argv[4], "fixed") == 0;
     int k = fixed || NH_ALLOC < 5 ? NH_ALLOC : 5, g = 0, j, n;
     long qp_iterations = 0;
+    double total_ms = 0.0, prepare_ms = 0.0;
     rng_state = (unsigned long long)(argc > 2 ? atol(argv[2]) : 1) * 2654435761ULL + 1ULL;
     if (NH_ALLOC > 64) return 100;
     S(solver_init)(&solver);
@@ -149,6 +166,8 @@ int main(int argc, char **argv)
         if (out.stop_reason >= 0 && out.stop_reason < N_REASONS) counts[out.stop_reason]++;
         qp_iterations += out.qp_iterations;
         if (out.time_total_ms > worst_ms) worst_ms = out.time_total_ms;
+        total_ms += out.time_total_ms;
+        prepare_ms += out.time_prepare_ms;
         closest = fmin(closest, d_now);
 
         { /* the plant: the unicycle under the command, finely integrated */
@@ -171,6 +190,12 @@ int main(int argc, char **argv)
            steps, violations, injected, worst_ms, closest);
     for (j = 1; j < N_REASONS; j++)
         printf("\"%s\": %ld%s", S(stop_reason_message)(j), counts[j], j + 1 < N_REASONS ? ", " : "");
-    printf("}, \"no_stop\": %ld, \"qp_iterations_mean\": %.2f}\n", counts[0], (double)qp_iterations / (double)steps);
+    printf("}, \"no_stop\": %ld, \"qp_iterations_mean\": %.2f, \"step_us\": %.3f, \"prepare_us\": %.3f",
+           counts[0], (double)qp_iterations / (double)steps, 1e3 * total_ms / (double)steps,
+           1e3 * prepare_ms / (double)steps);
+#ifdef OCP_QP_IPM_PROFILE
+    for (j = 0; j < 7; j++) printf(", \"%s_us\": %.3f", profile_parts[j], 1e-3 * ocp_qp_ipm_profile_ns[j] / (double)steps);
+#endif
+    printf("}\n");
     return violations > 100 ? 100 : (int)violations;
 }
