@@ -104,13 +104,25 @@ typedef struct HM_NS(ocp_qp_ipm_arg) {
     HM_REAL step_frac;       /* fraction of the step to the boundary that is taken */
     HM_REAL min_step;        /* a shorter step means no progress: HM_QP_NUMERICAL */
     int polish;              /* 1: refine a solution on its active set (ocp_qp_ipm.h) */
-    int residuals;           /* 1: ws->res holds the KKT residuals of the returned solution; 0: a solved
+    int residuals;           /* 1: ws->out.res holds the KKT residuals of the returned solution; 0: a solved
                                 QP's are left out (the polish still measures them) */
     int detect_unbounded;    /* 1: test stalling steps for a ray of unbounded descent (ocp_qp_ipm.h); 0 for
                                 QPs bounded by construction */
     int (*should_stop)(void *ctx);   /* polled once per iteration; nonzero ends with HM_QP_TIMEOUT */
     void *stop_ctx;
 } HM_NS(ocp_qp_ipm_arg);
+
+/* Outcome of a solve, as both QP solvers report it (the interior-point solver hands over its
+ * fallback's as its own). */
+typedef struct HM_NS(ocp_qp_outcome) {
+    int status;
+    int iter;                         /* interior-point iterations done */
+    HM_NS(ocp_qp_res) res;            /* residuals of the returned solution (ocp_qp_res_compute) */
+    HM_REAL res_primal, res_dual, gap;   /* the scaled measures compared with arg->tol */
+    HM_REAL mu;                       /* of the last iterate */
+    int unbounded;                    /* NUMERICAL because a direction of unbounded descent was found */
+    int polished;                     /* the solution is the active-set refinement of the iterate */
+} HM_NS(ocp_qp_outcome);
 
 /* One stage of the solver: its inequality families, its part of the iterate and of the direction,
  * and its part of the Newton system. Stage n carries (u_n, x_n) as one 6-vector ux (u first; u of
@@ -200,13 +212,8 @@ typedef struct HM_NS(ocp_qp_hsde_vec) {
 /* The fallback solver (ocp_qp_hsde.h): inequality rows (present bounds, general rows, s >= 0 of
  * soft rows) packed stage after stage into flat arrays. */
 typedef struct HM_NS(ocp_qp_hsde_ws) {
-    int status;
-    int iter;                         /* interior-point iterations done */
-    HM_NS(ocp_qp_res) res;            /* residuals of the returned solution (ocp_qp_res_compute) */
-    HM_REAL res_primal, res_dual, gap;   /* the scaled measures compared with arg->tol */
-    HM_REAL mu, tau, kappa;           /* of the last iterate */
-    int unbounded;                    /* NUMERICAL because a direction of unbounded descent was found */
-    int polished;                     /* the solution is the active-set refinement of the iterate */
+    HM_NS(ocp_qp_outcome) out;        /* of the last solve */
+    HM_REAL tau, kappa;               /* of the last iterate */
 
     /* packed inequality rows of stage n from off[n]: nb[n] bounds, nr[n] general rows, ns[n] rows
      * s >= 0 of the soft ones among them; m rows in all */
@@ -256,14 +263,7 @@ typedef struct HM_NS(ocp_qp_hsde_ws) {
 
 /* All memory of a solve. Only the first block is meant for the caller. */
 typedef struct HM_NS(ocp_qp_ipm_ws) {
-    /* outcome of the last solve */
-    int status;
-    int iter;                         /* interior-point iterations done */
-    HM_NS(ocp_qp_res) res;            /* residuals of the returned solution (ocp_qp_res_compute) */
-    HM_REAL res_primal, res_dual, gap;   /* the scaled measures compared with arg->tol */
-    HM_REAL mu;                       /* of the last iterate */
-    int unbounded;                    /* NUMERICAL because a direction of unbounded descent was found */
-    int polished;                     /* the solution is the active-set refinement of the iterate */
+    HM_NS(ocp_qp_outcome) out;        /* of the last solve */
 
     /* the problem as the solver sees it, and its iterate */
     int m;                            /* inequalities (present bound sides, rows, s >= 0) */

@@ -471,7 +471,7 @@ static void ocp_nlp_size_screening(hm_solver *s)
 }
 
 /* Solve the QP of the current linearisation (its x0 offset set), screened; residuals: the caller
- * reads ipm_ws.res. Returns the QP status. */
+ * reads ipm_ws.out.res. Returns the QP status. */
 static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int *qp_iter)
 {
     const int screen = s->params.row_screening && s->screen_radius[0] < HM_INF;
@@ -482,7 +482,7 @@ static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int *qp_it
     if (screen) ocp_nlp_screen_rows(s);
     for (round = 0;; round++) {
         status = ocp_qp_ipm_solve(&s->qp, &s->qp_sol, &s->ipm_ws, &s->ipm_arg);
-        *qp_iter += s->ipm_ws.iter;
+        *qp_iter += s->ipm_ws.out.iter;
         s->qp_solves++;
         if (!screen || !ocp_nlp_qp_usable(status)) break;
         if (round == OCP_NLP_SCREEN_ROUNDS) {
@@ -604,7 +604,7 @@ static int ocp_nlp_qp_line_search_step(hm_solver *s, const hm_input *in, hm_real
     merit0 = s->cost + s->merit_mu * gaps;
     /* The QP model of the merit after the full step: smooth objective + QP objective (its slack
      * penalties included) and linearised gaps closed. */
-    predicted = merit0 - (s->cost - s->cost_slack + s->ipm_ws.res.obj);
+    predicted = merit0 - (s->cost - s->cost_slack + s->ipm_ws.out.res.obj);
     ocp_nlp_save_base(s);
     for (;;) {
         ocp_nlp_step_from_base(s, alpha);

@@ -875,7 +875,7 @@ HM_FUNC void ocp_qp_hsde_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
     /* dropped rows keep a weight far below rounding level, not zero: a soft row's slack may have
      * neither curvature nor an active bound, and its elimination divides by the sum of the three */
     const hm_real w_drop = HM_EPS * HM_EPS / ws->w_max;
-    const hm_real before = ocp_qp_res_worst(&ws->res);
+    const hm_real before = ocp_qp_res_worst(&ws->out.res);
     hm_ocp_qp_res res;
     ocp_qp_hsde_sums sm;
     int j, k, n, i, round, dropped = 1;
@@ -920,15 +920,15 @@ HM_FUNC void ocp_qp_hsde_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
     ocp_qp_hsde_write_sol(qp, ws, d, sol, HM_R(1.0) / ws->cost_scale, HM_R(1.0));
     ocp_qp_res_compute(qp, sol, &res);
     if (ocp_qp_res_worst(&res) < before) {
-        ws->res = res;
-        ws->polished = 1;
+        ws->out.res = res;
+        ws->out.polished = 1;
     } else {
         ocp_qp_hsde_write_sol(qp, ws, &ws->v, sol, HM_R(1.0) / (ws->tau * ws->cost_scale), HM_R(1.0) / ws->tau);
     }
 }
 
 /* Ends a solve: the solution, the certificate (with b' w = bw) or zeros (before the first iterate,
- * or for non-finite iterates) into sol, its residuals into ws->res. */
+ * or for non-finite iterates) into sol, its residuals into ws->out.res. */
 HM_FUNC int ocp_qp_hsde_finish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_hsde_ws *ws, int status,
                               hm_real bw, int have_iterate, int polish)
 {
@@ -939,9 +939,9 @@ HM_FUNC int ocp_qp_hsde_finish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
     } else {
         ocp_qp_hsde_write_sol(qp, ws, &ws->v, sol, HM_R(1.0) / (ws->tau * ws->cost_scale), HM_R(1.0) / ws->tau);
     }
-    ocp_qp_res_compute(qp, sol, &ws->res);
+    ocp_qp_res_compute(qp, sol, &ws->out.res);
     if (status == HM_QP_SOLVED && polish) ocp_qp_hsde_polish(qp, sol, ws);
-    ws->status = status;
+    ws->out.status = status;
     return status;
 }
 
@@ -952,10 +952,10 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
     ocp_qp_hsde_sums sm;
     hm_real mu0 = HM_R(1.0);
 
-    ws->iter = 0;
-    ws->unbounded = 0;
-    ws->polished = 0;
-    ws->res_primal = ws->res_dual = ws->gap = ws->mu = HM_R(0.0);
+    ws->out.iter = 0;
+    ws->out.unbounded = 0;
+    ws->out.polished = 0;
+    ws->out.res_primal = ws->out.res_dual = ws->out.gap = ws->out.mu = HM_R(0.0);
     ws->tau = ws->kappa = HM_R(1.0);
 
     status = ocp_qp_check(qp);
@@ -963,8 +963,8 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
     status = ocp_qp_hsde_setup(qp, ws, &bad);
     if (status == HM_QP_INFEASIBLE) {
         ocp_qp_sol_box_certificate(qp, sol, bad);
-        ocp_qp_res_compute(qp, sol, &ws->res);
-        ws->status = status;
+        ocp_qp_res_compute(qp, sol, &ws->out.res);
+        ws->out.status = status;
         return status;
     }
     status = ocp_qp_hsde_init(qp, ws);
@@ -976,8 +976,8 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
 
         ocp_qp_hsde_residuals(qp, ws, &ws->v, ws->t, ws->tau, 1, &sm);
         mu = (sm.tz + ws->tau * ws->kappa) / mdeg;
-        if (ws->iter == 0) mu0 = mu;
-        ws->mu = mu;
+        if (ws->out.iter == 0) mu0 = mu;
+        ws->out.mu = mu;
         if (!isfinite(mu + sm.rd + sm.rp + ws->rtau + sm.nv + sm.nw)) {
             status = HM_QP_NONFINITE;
             break;
@@ -993,9 +993,9 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
         pcost = (sm.qv * tinv + HM_R(0.5) * sm.vPv * tinv * tinv) / ws->cost_scale;
         gap = sm.tz * tinv * tinv / ws->cost_scale;
         gap_rel = gap / OCP_QP_HSDE_MAX(HM_R(1.0), hm_fabs(pcost));
-        ws->res_primal = res_p;
-        ws->res_dual = res_d;
-        ws->gap = gap_rel;
+        ws->out.res_primal = res_p;
+        ws->out.res_dual = res_d;
+        ws->out.gap = gap_rel;
         if (ws->kappa <= ws->tau && res_p <= arg->tol && res_d <= arg->tol
             && (gap <= arg->tol || gap_rel <= arg->tol)) {
             status = HM_QP_SOLVED;
@@ -1009,12 +1009,12 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
             const hm_real cinv = HM_R(1.0) / ws->cost_scale;
             if (arg->detect_unbounded && sm.qv < HM_R(0.0)
                 && OCP_QP_HSDE_MAX(sm.pv * cinv, OCP_QP_HSDE_MAX(sm.av_eq, sm.av_ineq)) <= arg->tol_infeas * -sm.qv * cinv) {
-                ws->unbounded = 1;
+                ws->out.unbounded = 1;
                 status = HM_QP_NUMERICAL;
                 break;
             }
         }
-        if (ws->iter >= arg->max_iter) {
+        if (ws->out.iter >= arg->max_iter) {
             status = HM_QP_MAX_ITER;
             break;
         }
@@ -1028,7 +1028,7 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
             status = HM_QP_TIMEOUT;
             break;
         }
-        ws->iter++;
+        ws->out.iter++;
 
         /* Newton matrix (weights from ocp_qp_hsde_residuals), and its solve for the constant right-hand
          * side (v1, w1) = K^-1 (-q, b) */
@@ -1051,7 +1051,7 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
 
         /* Mehrotra corrector, with only part of the second-order term in the first iteration, whose
          * start may be far from central */
-        corr = ws->iter > 1 ? HM_R(1.0) : alpha_aff;
+        corr = ws->out.iter > 1 ? HM_R(1.0) : alpha_aff;
         for (j = 0; j < ws->m; j++) ws->ds[j] += corr * ws->dt[j] * ws->dv.z[j] - sigma * mu;
         dk = ws->tau * ws->kappa + corr * ws->dtau * ws->dkappa - sigma * mu;
         alpha = ocp_qp_hsde_direction(qp, ws, HM_R(1.0) - sigma, dk, den);

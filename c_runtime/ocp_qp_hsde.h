@@ -16,7 +16,7 @@
  *
  * Termination as in ocp_qp_ipm.h with the QP point v / tau, SOLVED only with kappa <= tau; with
  * kappa > tau, INFEASIBLE when (y, z) is a Farkas certificate (b' w < 0, ||A' w|| <= tol_infeas
- * (-b' w)), NUMERICAL with ws->unbounded when v is a direction of unbounded descent (q' v < 0 with
+ * (-b' w)), NUMERICAL with ws->out.unbounded when v is a direction of unbounded descent (q' v < 0 with
  * P v, A_E v and A_I v + t small against it). The embedding drives tau -> 0 on infeasible problems
  * at the rate it converges on feasible ones, so the certificate appears in a bounded number of
  * iterations (measured: 7-28, typically 15).
@@ -30,7 +30,7 @@
 #define HM_QP_HSDE_NC_STAGE (2 * (HM_NU + HM_NX) + 2 * HM_NG)
 #define HM_QP_HSDE_NC_MAX ((HM_N + 1) * HM_QP_HSDE_NC_STAGE)
 
-/* Solve qp from scratch; returns an enum hm_qp_status (also in ws->status); ws->iter iterations. */
+/* Solve qp from scratch; returns an enum hm_qp_status (also in ws->out.status); ws->out.iter iterations. */
 HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_hsde_ws *ws,
                               const hm_ocp_qp_ipm_arg *arg);
 

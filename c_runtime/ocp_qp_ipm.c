@@ -1312,7 +1312,7 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
     /* dropped inequalities keep a weight far below rounding level, not zero: a soft row's slack may
      * have neither curvature nor an active bound, and its elimination divides by the sum of three */
     const hm_real w_drop = HM_EPS * HM_EPS / wmax;
-    const hm_real before = ocp_qp_res_worst(&ws->res);
+    const hm_real before = ocp_qp_res_worst(&ws->out.res);
     hm_ocp_qp_res res;
     int n, i, k, j, l, round, changed = 1;
 
@@ -1393,8 +1393,8 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
            (double)ocp_qp_res_worst(&res), (double)res.stat, (double)res.eq, (double)res.ineq, (double)res.comp, (double)res.dual);
 #endif
     if (ocp_qp_res_worst(&res) < before) {
-        ws->res = res;
-        ws->polished = 1;
+        ws->out.res = res;
+        ws->out.polished = 1;
     } else {
         ocp_qp_ipm_write_sol(qp, ws, sol, HM_R(1.0) / ws->cost_scale, HM_R(1.0));
     }
@@ -1405,7 +1405,7 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
  * ---------------------------------------------------------------------------------------------- */
 
 /* Ends a solve: the solution, the certificate (with b' w = bw) or zeros (before the first iterate,
- * or for non-finite iterates) into sol, its residuals into ws->res. */
+ * or for non-finite iterates) into sol, its residuals into ws->out.res. */
 HM_FUNC int ocp_qp_ipm_finish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws, int status,
                               hm_real bw, int have_iterate, int polish, int residuals, hm_real alpha)
 {
@@ -1418,12 +1418,12 @@ HM_FUNC int ocp_qp_ipm_finish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
     }
     polish = status == HM_QP_SOLVED && (polish == 1 || (polish == 2 && ocp_qp_ipm_undecided(ws, alpha)));
     if (residuals || polish || status != HM_QP_SOLVED) {
-        ocp_qp_res_compute(qp, sol, &ws->res);
+        ocp_qp_res_compute(qp, sol, &ws->out.res);
     } else {
-        ws->res.stat = ws->res.eq = ws->res.ineq = ws->res.comp = ws->res.dual = ws->res.obj = HM_R(0.0);
+        ws->out.res.stat = ws->out.res.eq = ws->out.res.ineq = ws->out.res.comp = ws->out.res.dual = ws->out.res.obj = HM_R(0.0);
     }
     if (polish) ocp_qp_ipm_polish(qp, sol, ws, alpha);
-    ws->status = status;
+    ws->out.status = status;
     return status;
 }
 
@@ -1434,20 +1434,13 @@ HM_FUNC int ocp_qp_ipm_fallback(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
 {
     hm_ocp_qp_ipm_arg a = *arg;
     hm_ocp_qp_hsde_ws *h = &ws->u.hsde;
-    const int done = ws->iter;
+    const int done = ws->out.iter;
     int status;
     a.max_iter = arg->max_iter - done;
     status = ocp_qp_hsde_solve(qp, sol, h, &a);
     ws->fallback = 1;
-    ws->status = status;
-    ws->iter = done + h->iter;
-    ws->res = h->res;
-    ws->res_primal = h->res_primal;
-    ws->res_dual = h->res_dual;
-    ws->gap = h->gap;
-    ws->mu = h->mu;
-    ws->unbounded = h->unbounded;
-    ws->polished = h->polished;
+    ws->out = h->out;
+    ws->out.iter = done + h->out.iter;
     return status;
 }
 
@@ -1459,19 +1452,19 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
     hm_real mu0 = HM_R(1.0), alpha = HM_R(0.0), alpha_prev = HM_R(1.0), rp0 = HM_R(0.0);
     hm_real mu_hist[OCP_QP_IPM_STALL_ITERS] = {HM_R(0.0)};
 
-    ws->iter = 0;
-    ws->unbounded = 0;
-    ws->polished = 0;
+    ws->out.iter = 0;
+    ws->out.unbounded = 0;
+    ws->out.polished = 0;
     ws->fallback = 0;
-    ws->res_primal = ws->res_dual = ws->gap = ws->mu = HM_R(0.0);
+    ws->out.res_primal = ws->out.res_dual = ws->out.gap = ws->out.mu = HM_R(0.0);
 
     OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_SETUP, status = ocp_qp_check(qp));
     if (status) return ocp_qp_ipm_finish(qp, sol, ws, status, HM_R(0.0), 0, 0, 1, HM_R(0.0));
     OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_SETUP, status = ocp_qp_ipm_setup(qp, ws, &bad));
     if (status == HM_QP_INFEASIBLE) {
         ocp_qp_sol_box_certificate(qp, sol, bad);
-        ocp_qp_res_compute(qp, sol, &ws->res);
-        ws->status = status;
+        ocp_qp_res_compute(qp, sol, &ws->out.res);
+        ws->out.status = status;
         return status;
     }
 
@@ -1483,11 +1476,11 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
 
         OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_A, ocp_qp_ipm_pass_a(qp, ws, alpha, &sm));
         mu = sm.tz / mdeg;
-        if (ws->iter == 0) {
+        if (ws->out.iter == 0) {
             mu0 = mu;
             rp0 = sm.rp;
         }
-        ws->mu = mu;
+        ws->out.mu = mu;
         /* a NaN anywhere in the iterate reaches one of these sums (t, z, s through t'z; v through
          * q'v and v'Pv, which multiply every entry; y through b'w) */
         if (!isfinite(mu + sm.rd + sm.rp + sm.qv + sm.bw + sm.vPv)) {
@@ -1516,9 +1509,9 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         pcost = (sm.qv + HM_R(0.5) * sm.vPv) * cinv;
         gap = sm.tz * cinv;
         gap_rel = gap / OCP_QP_IPM_MAX(HM_R(1.0), hm_fabs(pcost));
-        ws->res_primal = res_p;
-        ws->res_dual = res_d;
-        ws->gap = gap_rel;
+        ws->out.res_primal = res_p;
+        ws->out.res_dual = res_d;
+        ws->out.gap = gap_rel;
         /* and the natural residual of complementarity, max min(t, z): the product t z bounds the
          * distance to the solution only through its square root when a multiplier is small, the
          * natural residual linearly; near-degenerate QPs need it, others meet it with the gap */
@@ -1531,7 +1524,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
             status = HM_QP_INFEASIBLE;
             break;
         }
-        if (ws->iter > 0 && alpha < HM_R(0.5)) {
+        if (ws->out.iter > 0 && alpha < HM_R(0.5)) {
             hm_real bwr;
             ocp_qp_ipm_ray_from_step(ws);
             if (ocp_qp_ipm_farkas(qp, ws, &ws->u.f.va, arg->tol_infeas, &bwr)) {
@@ -1543,14 +1536,14 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         }
         /* a stalling iteration (short steps) may be on a problem without solution: test the last
          * step as a ray (ocp_qp_ipm_farkas, ocp_qp_ipm_unbounded_ray) */
-        if (arg->detect_unbounded && ws->iter > 0 && alpha < HM_R(0.5)) {
+        if (arg->detect_unbounded && ws->out.iter > 0 && alpha < HM_R(0.5)) {
             if (ocp_qp_ipm_unbounded_ray(qp, ws, arg->tol_infeas)) {
-                ws->unbounded = 1;
+                ws->out.unbounded = 1;
                 status = HM_QP_NUMERICAL;
                 break;
             }
         }
-        if (ws->iter >= arg->max_iter) {
+        if (ws->out.iter >= arg->max_iter) {
             status = HM_QP_MAX_ITER;
             break;
         }
@@ -1563,13 +1556,13 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         /* A stalling iteration (two short steps in a row), or residuals that do not fall with mu,
          * is what an infeasible (or unbounded) problem does to this method when the certificate tests
          * above have not caught it: hand over to the embedding, which handles those robustly. */
-        if (ws->iter > 1 && alpha < HM_R(0.1) && alpha_prev < HM_R(0.1)) {
+        if (ws->out.iter > 1 && alpha < HM_R(0.1) && alpha_prev < HM_R(0.1)) {
             fallback = 1;
             break;
         }
         /* (only while the primal residual is above tol: once it is met, a residual that no longer
          * falls is at its rounding floor, as single precision reaches with mu still falling) */
-        if (ws->iter > 1 && res_p > arg->tol && mu < HM_R(1e-2) * mu0 && sm.rp * mu0 > HM_R(1e3) * rp0 * mu) {
+        if (ws->out.iter > 1 && res_p > arg->tol && mu < HM_R(1e-2) * mu0 && sm.rp * mu0 > HM_R(1e3) * rp0 * mu) {
             fallback = 1;
             break;
         }
@@ -1578,17 +1571,17 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
          * blocks every direction after a few roundings, and the iteration cycles between a blocked
          * affine step and a short centring step (seen on RTI QPs with screened rows: mu 1e-7 to
          * 3e-7 and back for 40 iterations). The embedding has no such pair. */
-        if (ws->iter >= OCP_QP_IPM_STALL_ITERS && res_p <= arg->tol && res_d <= arg->tol
-            && mu > HM_R(0.25) * mu_hist[ws->iter % OCP_QP_IPM_STALL_ITERS]) {
+        if (ws->out.iter >= OCP_QP_IPM_STALL_ITERS && res_p <= arg->tol && res_d <= arg->tol
+            && mu > HM_R(0.25) * mu_hist[ws->out.iter % OCP_QP_IPM_STALL_ITERS]) {
             fallback = 1;
             break;
         }
-        mu_hist[ws->iter % OCP_QP_IPM_STALL_ITERS] = mu;
+        mu_hist[ws->out.iter % OCP_QP_IPM_STALL_ITERS] = mu;
         if (arg->should_stop && arg->should_stop(arg->stop_ctx)) {
             status = HM_QP_TIMEOUT;
             break;
         }
-        ws->iter++;
+        ws->out.iter++;
 
         alpha_prev = alpha;
 
@@ -1597,7 +1590,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         if (singular) {
             /* singular at the start: the QP is not strictly convex in u; later: the weights of a
              * diverging iteration */
-            if (ws->iter > 1) fallback = 1;
+            if (ws->out.iter > 1) fallback = 1;
             status = HM_QP_NUMERICAL;
             break;
         }
@@ -1631,9 +1624,9 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
             extern double g_stat_min2alpha, g_stat_incons;
             static double prev_alpha = 1.0, rp0 = 0.0;
             const double a2 = (double)(alpha > prev_alpha ? alpha : prev_alpha);
-            if (ws->iter == 1) { prev_alpha = 1.0; rp0 = (double)sm.rp; g_stat_min2alpha = 1.0; g_stat_incons = 0.0; }
-            if (ws->iter > 1 && a2 < g_stat_min2alpha) g_stat_min2alpha = a2;
-            if (ws->iter > 1) {
+            if (ws->out.iter == 1) { prev_alpha = 1.0; rp0 = (double)sm.rp; g_stat_min2alpha = 1.0; g_stat_incons = 0.0; }
+            if (ws->out.iter > 1 && a2 < g_stat_min2alpha) g_stat_min2alpha = a2;
+            if (ws->out.iter > 1) {
                 const double inc = ((double)sm.rp / rp0) / ((double)mu / (double)mu0);
                 if ((double)mu / (double)mu0 < 1e-2 && inc > g_stat_incons) g_stat_incons = inc;
             }
@@ -1642,7 +1635,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
 #endif
 #ifdef OCP_QP_IPM_TRACE
         printf("it %2d mu %.3e res_p %.2e res_d %.2e gap %.2e gap_rel %.2e | a_aff %.4f sigma %.2e alpha %.6f bw %.2e atw %.2e\n",
-               ws->iter, (double)mu, (double)res_p, (double)res_d, (double)gap, (double)gap_rel, (double)alpha_aff,
+               ws->out.iter, (double)mu, (double)res_p, (double)res_d, (double)gap, (double)gap_rel, (double)alpha_aff,
                (double)sigma, (double)alpha, (double)sm.bw, (double)sm.atw);
 #endif
         if (!(alpha >= arg->min_step)) {
@@ -1660,8 +1653,8 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
     }
     if (ray) {
         ocp_qp_ipm_write_sol_vec(qp, ws, &ws->u.f.va, sol, HM_R(1.0) / -sm.bw);
-        ocp_qp_res_compute(qp, sol, &ws->res);
-        ws->status = status;
+        ocp_qp_res_compute(qp, sol, &ws->out.res);
+        ws->out.status = status;
         return status;
     }
     OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_FINISH,

@@ -22,7 +22,7 @@
  *               data) in absolute terms or relative to max(1, |cost|), all below arg->tol. Then, with
  *               arg->polish, the active-set polish (ocp_qp_ipm.c): the QP solved once more as an
  *               equality-constrained QP on the rows the iterate has active, kept only if its worst
- *               KKT residual (ocp_qp_res_compute) is smaller (ws->polished).
+ *               KKT residual (ocp_qp_res_compute) is smaller (ws->out.polished).
  *   INFEASIBLE  the dual iterate is a Farkas certificate: b' w < 0 and ||A' w||_inf <=
  *               tol_infeas * (-b' w), w = (y, z), z >= 0 (as every iterate's). Then every (u, x, s)
  *               satisfying the hard constraints has ||(u, x, s)||_1 >= 1 / tol_infeas: there is none
@@ -37,7 +37,7 @@
  *               arg->min_step, mu fell below eps^2 mu_0 (the residuals are stuck at their rounding
  *               floor above tol), or (with arg->detect_unbounded) a direction of unbounded
  *               descent was found: q' v < 0 with
- *               P v, A_E v - b_E... see ocp_qp_ipm.c (ws->unbounded = 1; no minimiser).
+ *               P v, A_E v - b_E... see ocp_qp_ipm.c (ws->out.unbounded = 1; no minimiser).
  *   NONFINITE   NaN or Inf in the data (checked before any work) or in the iterates.
  *   MAX_ITER / TIMEOUT  arg->max_iter iterations done / arg->should_stop returned nonzero (polled
  *               once per iteration, before its work).
@@ -48,7 +48,7 @@
  * of ocp_qp.h with every cost term (Q, S, R, q, r, zl, Zl) set to zero, are >= 0, and
  *     sum_n pi_n' c_n + lbu' lam_lbu - ubu' lam_ubu + lbx' lam_lbx - ubx' lam_ubx + lg' lam_lg = 1
  * (sums over present bounds and rows, c_0 = b_0 + A_0 x0, c_n = b_n). For NONFINITE sol is zeroed.
- * ws->iter, ws->res (ocp_qp_res_compute of sol) and the scaled measures report the solve.
+ * ws->out.iter, ws->out.res (ocp_qp_res_compute of sol) and the scaled measures report the solve.
  */
 #ifndef OCP_QP_IPM_H
 #define OCP_QP_IPM_H
@@ -59,7 +59,7 @@
  * min_step 1e-8, no polish, no stop hook. */
 HM_FUNC void ocp_qp_ipm_arg_set_default(hm_ocp_qp_ipm_arg *arg);
 
-/* Solve qp; returns an enum hm_qp_status (also in ws->status). */
+/* Solve qp; returns an enum hm_qp_status (also in ws->out.status). */
 HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws,
                              const hm_ocp_qp_ipm_arg *arg);
 

@@ -179,11 +179,11 @@ static int bench_file(const char *path, int reps, const hm_ocp_qp_ipm_arg *arg)
         }
         qsort(times, (size_t)r, sizeof times[0], cmp_double);
         g_med[count] = times[r / 2];
-        g_iters[count] = g_ws.iter;
-        g_per_iter[count] = times[r / 2] / (g_ws.iter > 0 ? g_ws.iter : 1);
-        it_sum += g_ws.iter;
+        g_iters[count] = g_ws.out.iter;
+        g_per_iter[count] = times[r / 2] / (g_ws.out.iter > 0 ? g_ws.out.iter : 1);
+        it_sum += g_ws.out.iter;
         fallbacks += g_ws.fallback;
-        it_hist[g_ws.iter < 63 ? g_ws.iter : 63]++;
+        it_hist[g_ws.out.iter < 63 ? g_ws.out.iter : 63]++;
         if (status >= 0 && status < 6) status_count[status]++;
         count++;
     }
@@ -222,7 +222,7 @@ int main(int argc, char **argv)
             const double t0 = now_s();
             status = ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, &arg);
             times[r] = now_s() - t0;
-            iters = g_ws.iter;
+            iters = g_ws.out.iter;
         }
         qsort(times, (size_t)r, sizeof times[0], cmp_double);
         med = times[r / 2];
@@ -230,7 +230,7 @@ int main(int argc, char **argv)
         printf("N=%d NG=%d case %d: %s, iterations %d  median %.2f us/solve %.2f us/iter  min %.2f us/solve"
                "  (stat %.1e eq %.1e ineq %.1e comp %.1e)\n",
                HM_N, HM_NG, c, ocp_qp_status_message(status), iters, 1e6 * med, 1e6 * med / (iters > 0 ? iters : 1), 1e6 * mn,
-               g_ws.res.stat, g_ws.res.eq, g_ws.res.ineq, g_ws.res.comp);
+               g_ws.out.res.stat, g_ws.out.res.eq, g_ws.out.res.ineq, g_ws.out.res.comp);
     }
     return 0;
 }

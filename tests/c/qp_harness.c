@@ -134,17 +134,17 @@ static void qp_harness_copy_res(const hm_ocp_qp_res *res, double *res6)
  * status. */
 int qp_harness_info(int *iter, int *polls, int *flags, double *res6, double *scaled3, double *mtk3)
 {
-    *iter = g_ws.iter;
+    *iter = g_ws.out.iter;
     *polls = g_polls;
-    *flags = g_ws.unbounded + 2 * g_ws.polished + 4 * g_ws.fallback;
-    qp_harness_copy_res(&g_ws.res, res6);
-    scaled3[0] = (double)g_ws.res_primal;
-    scaled3[1] = (double)g_ws.res_dual;
-    scaled3[2] = (double)g_ws.gap;
-    mtk3[0] = (double)g_ws.mu;
+    *flags = g_ws.out.unbounded + 2 * g_ws.out.polished + 4 * g_ws.fallback;
+    qp_harness_copy_res(&g_ws.out.res, res6);
+    scaled3[0] = (double)g_ws.out.res_primal;
+    scaled3[1] = (double)g_ws.out.res_dual;
+    scaled3[2] = (double)g_ws.out.gap;
+    mtk3[0] = (double)g_ws.out.mu;
     mtk3[1] = 1.0; /* tau and kappa of the homogeneous embedding the solver no longer uses */
     mtk3[2] = 0.0;
-    return g_ws.status;
+    return g_ws.out.status;
 }
 
 /* ocp_qp_res_compute of the current problem and solution (which Python may have edited). */

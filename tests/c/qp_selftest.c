@@ -136,14 +136,14 @@ static void check_solved(const hm_ocp_qp_ipm_arg *arg, int case_id)
     hm_ocp_qp_res res;
     check(status == HM_QP_SOLVED, "feasible QP solved", case_id);
     ocp_qp_res_compute(&g_qp, &g_sol, &res);
-    if (getenv("QPS_VERBOSE")) printf("case %d: stat %g eq %g ineq %g comp %g dual %g obj %g iter %d status %d\n", case_id, (double)res.stat, (double)res.eq, (double)res.ineq, (double)res.comp, (double)res.dual, (double)res.obj, g_ws.iter, status);
+    if (getenv("QPS_VERBOSE")) printf("case %d: stat %g eq %g ineq %g comp %g dual %g obj %g iter %d status %d\n", case_id, (double)res.stat, (double)res.eq, (double)res.ineq, (double)res.comp, (double)res.dual, (double)res.obj, g_ws.out.iter, status);
     /* the solver's tolerance is relative: the gap (sum of complementarity products) against the
      * objective, stationarity against the gradient terms (all O(1) here, up to ~10 with the bounds) */
     check(res.stat < (hm_real)(TOL_RES * 10) && res.eq < (hm_real)TOL_RES && res.ineq < (hm_real)TOL_RES
           && res.comp < (hm_real)TOL_RES * (1 + hm_fabs(res.obj)) && res.dual <= 0,
           "KKT residuals of the solution", case_id);
-    check(res.stat == g_ws.res.stat && res.comp == g_ws.res.comp, "workspace reports the residuals", case_id);
-    check(g_ws.iter > 0 && g_ws.iter < 40, "iteration count", case_id);
+    check(res.stat == g_ws.out.res.stat && res.comp == g_ws.out.res.comp, "workspace reports the residuals", case_id);
+    check(g_ws.out.iter > 0 && g_ws.out.iter < 40, "iteration count", case_id);
 }
 
 /* The certificate of ocp_qp_ipm.h: stationarity without the cost, value 1, signs. */
@@ -232,13 +232,13 @@ int main(void)
     g_qp.lbx[3][2] = 1;
     g_qp.ubx[3][2] = 0;
     status = ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, &arg);
-    check(status == HM_QP_INFEASIBLE && g_ws.iter == 0, "crossing bounds", 300);
+    check(status == HM_QP_INFEASIBLE && g_ws.out.iter == 0, "crossing bounds", 300);
     if (status == HM_QP_INFEASIBLE) check_certificate(300);
 
     /* non-finite data */
     make_qp(0, xref);
     g_qp.B[4][3] = (hm_real)NAN;
-    check(ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, &arg) == HM_QP_NONFINITE && g_ws.iter == 0, "NaN in B", 400);
+    check(ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, &arg) == HM_QP_NONFINITE && g_ws.out.iter == 0, "NaN in B", 400);
     make_qp(0, xref);
     g_qp.q[HM_N][1] = (hm_real)INFINITY;
     check(ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, &arg) == HM_QP_NONFINITE, "Inf in q", 401);
@@ -251,13 +251,13 @@ int main(void)
     arg.should_stop = stop_after_three;
     g_polls = 0;
     status = ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, &arg);
-    check(status == HM_QP_TIMEOUT && g_ws.iter == 3 && g_polls == 4, "stop hook", 500);
+    check(status == HM_QP_TIMEOUT && g_ws.out.iter == 3 && g_polls == 4, "stop hook", 500);
     arg.should_stop = NULL;
 
     /* iteration limit */
     arg.max_iter = 2;
     status = ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, &arg);
-    check(status == HM_QP_MAX_ITER && g_ws.iter == 2, "iteration limit", 600);
+    check(status == HM_QP_MAX_ITER && g_ws.out.iter == 2, "iteration limit", 600);
     ocp_qp_ipm_arg_set_default(&arg);
 
     /* unbounded: an input without effect or curvature, bounded below only, whose cost falls as it
@@ -269,11 +269,11 @@ int main(void)
     g_qp.ubu[5][0] = (hm_real)HM_INF;
     for (c = 0; c < HM_NX; c++) g_qp.B[5][c] = 0;
     status = ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, &arg);
-    check(status == HM_QP_NUMERICAL && g_ws.unbounded, "unbounded QP detected", 700);
+    check(status == HM_QP_NUMERICAL && g_ws.out.unbounded, "unbounded QP detected", 700);
     /* the same input also unbounded below: its curvature is zero, the Newton matrix singular */
     g_qp.lbu[5][0] = (hm_real)-HM_INF;
     status = ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, &arg);
-    check(status == HM_QP_NUMERICAL && !g_ws.unbounded, "singular Newton matrix", 701);
+    check(status == HM_QP_NUMERICAL && !g_ws.out.unbounded, "singular Newton matrix", 701);
     printf("%s: %d failure(s); last status message: %s\n", g_failures ? "FAIL" : "OK", g_failures,
            ocp_qp_status_message(status));
     return g_failures;
