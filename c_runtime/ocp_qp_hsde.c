@@ -708,6 +708,23 @@ HM_FUNC hm_real ocp_qp_hsde_tau_pivot(const hm_ocp_qp *restrict qp, const hm_ocp
     return -acc;
 }
 
+/* y += a x on the (u, x), soft-slack and dynamics-multiplier parts (z is each caller's own). */
+HM_FUNC void ocp_qp_hsde_vec_axpy_except_z(const hm_ocp_qp_hsde_ws *restrict ws, hm_real a,
+                                         const hm_ocp_qp_hsde_vec *restrict x, hm_ocp_qp_hsde_vec *restrict y)
+{
+    int n, i, j;
+    for (n = 0; n <= HM_N; n++) {
+        for (i = 0; i < HM_QP_NUX; i++) y->ux[n][i] += a * x->ux[n][i];
+        for (j = 0; j < ws->ns[n]; j++) {
+            const int kr = ws->soft_of[n][j];
+            y->s[n][kr] += a * x->s[n][kr];
+        }
+    }
+    for (n = 0; n < HM_N; n++) {
+        for (i = 0; i < HM_NX; i++) y->y[n][i] += a * x->y[n][i];
+    }
+}
+
 /* The step (ws->dv, ws->dt, ws->dtau, ws->dkappa) that leaves (1 - keep) of the residuals, for the
  * complementarity targets t o z + z o dt + t o dz = t o z - ds (ds in ws->ds) and
  * tau kappa + kappa dtau + tau dkappa = tau kappa - dk. den is the tau pivot of this factorisation.
@@ -734,16 +751,7 @@ HM_FUNC hm_real ocp_qp_hsde_direction(const hm_ocp_qp *restrict qp, hm_ocp_qp_hs
     }
     for (j = 0; j < ws->m; j++) d->z[j] = ws->ds[j] * ws->zinv[j] - keep * r->z[j];
     dtau = (dk / tau - keep * ws->rtau - ocp_qp_hsde_kkt_solve(qp, ws, d, d)) / den;
-    for (n = 0; n <= HM_N; n++) {
-        for (i = 0; i < HM_QP_NUX; i++) d->ux[n][i] += dtau * v1->ux[n][i];
-        for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            d->s[n][kr] += dtau * v1->s[n][kr];
-        }
-    }
-    for (n = 0; n < HM_N; n++) {
-        for (i = 0; i < HM_NX; i++) d->y[n][i] += dtau * v1->y[n][i];
-    }
+    ocp_qp_hsde_vec_axpy_except_z(ws, dtau, v1, d);
     ws->dtau = dtau;
     ws->dkappa = -(dk + ws->kappa * dtau) / tau;
     if (-ws->dtau * a > ws->tau) a = -ws->tau / ws->dtau;
@@ -1069,17 +1077,7 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
         {
             hm_ocp_qp_hsde_vec *restrict v = &ws->v;
             const hm_ocp_qp_hsde_vec *restrict dv = &ws->dv;
-            int n, i;
-            for (n = 0; n <= HM_N; n++) {
-                for (i = 0; i < HM_QP_NUX; i++) v->ux[n][i] += alpha * dv->ux[n][i];
-                for (j = 0; j < ws->ns[n]; j++) {
-                    const int kr = ws->soft_of[n][j];
-                    v->s[n][kr] += alpha * dv->s[n][kr];
-                }
-            }
-            for (n = 0; n < HM_N; n++) {
-                for (i = 0; i < HM_NX; i++) v->y[n][i] += alpha * dv->y[n][i];
-            }
+            ocp_qp_hsde_vec_axpy_except_z(ws, alpha, dv, v);
             for (j = 0; j < ws->m; j++) {
                 v->z[j] += alpha * dv->z[j];
                 ws->t[j] += alpha * ws->dt[j];

@@ -37,7 +37,7 @@ QP_STATUS_NAMES = {
 
 
 def _field(key: str, convert: type) -> property:
-    """A scalar field of the output record, as a Python int or float."""
+    """A scalar field of the output record, as a Python bool, int or float."""
     return property(lambda self: convert(self._rec[key]), doc=f"the output's {key}")
 
 
@@ -66,10 +66,6 @@ class StepResult:
         return a if a.dtype == np.float64 else a.astype(np.float64)
 
     @property
-    def stop(self) -> bool:
-        return bool(self._rec["stop"])
-
-    @property
     def u0(self) -> FloatArray:
         return self._array("u0")
 
@@ -85,6 +81,7 @@ class StepResult:
     def u(self) -> FloatArray:
         return self._array("u")
 
+    stop = _field("stop", bool)
     stop_reason = _field("stop_reason", int)
     status = _field("status", int)
     qp_status = _field("qp_status", int)
