@@ -364,13 +364,17 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
     hm_real qv = HM_R(0.0), bw = HM_R(0.0), vPv = HM_R(0.0), tz = HM_R(0.0);
     hm_real atw_n = HM_R(0.0), pv_n = HM_R(0.0), aveq_n = HM_R(0.0);
     hm_real rd = HM_R(0.0), rp = HM_R(0.0);
+    /* The maxima are taken entry by entry across the stages and reduced at the end: the same
+     * numbers (max is exact in any order), in vector lanes instead of one scalar chain. */
+    hm_real rd_v[HM_QP_NUX], pv_v[HM_QP_NUX], atw_v[HM_QP_NUX], eq_v[HM_NX], rpe_v[HM_NX], rpb_v[2];
     int n, i, j, k, l;
 
+    for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = pv_v[i] = atw_v[i] = HM_R(0.0);
+    for (i = 0; i < HM_NX; i++) eq_v[i] = rpe_v[i] = HM_R(0.0);
+    rpb_v[0] = rpb_v[1] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
         hm_real *restrict ux = sn->ux;
-        const int c0 = n == HM_N ? HM_NU : 0;
-        const int c1 = n == 0 ? HM_NU : HM_QP_NUX;
         hm_real Pux[HM_QP_NUX], atw[HM_QP_NUX], hf[HM_QP_NUX], hmu[HM_QP_NUX], Hd[HM_QP_NUX];
 
         /* the step */
@@ -405,8 +409,8 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             for (i = 0; i < HM_NX; i++) {
                 const hm_real ri = e[i] - sp->beq[i];
                 sp->ry[i] = -ri;
-                aveq_n = OCP_QP_IPM_MAX(aveq_n, OCP_QP_IPM_ABS(e[i]));
-                rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_ABS(ri));
+                eq_v[i] = OCP_QP_IPM_MAX(eq_v[i], OCP_QP_IPM_ABS(e[i]));
+                rpe_v[i] = OCP_QP_IPM_MAX(rpe_v[i], OCP_QP_IPM_ABS(ri));
             }
         }
 
@@ -470,7 +474,7 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                 hf_l[l] = sg * w * rho;
                 mu_l[l] = sg * w * zi;
                 tz += msk * t * z;
-                rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_ABS(rho + t));
+                rpb_v[l] = OCP_QP_IPM_MAX(rpb_v[l], OCP_QP_IPM_ABS(rho + t));
                 bw += msk * b * z;
             }
             atw[c] += a_l[0] + a_l[1];
@@ -590,23 +594,34 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             sn->Hpp[0] = sn->Hpp[1] = sn->Hpp[2] = HM_R(0.0);
         }
 
-        /* stationarity of (u, x): r = P v + q + A' w, and the predictor's gradient r + A_I' W rho */
+        /* stationarity of (u, x): r = P v + q + A' w, and the predictor's gradient r + A_I' W rho.
+         * The parts absent at stage 0 (x) and stage N (u) are exact zeros in every term (no cost,
+         * no bounds, no rows, no dynamics there; v stays 0), so the sums and maxima run over all. */
         ocp_qp_ipm_hess_mul(sn, ux, Pux);
         for (i = 0; i < HM_QP_NUX; i++) {
             const hm_real ri = Pux[i] + sn->q[i] + atw[i];
             sn->ha[i] = ri + hf[i];
             sn->hmu[i] = hmu[i];
             sn->Hd[i] = Hd[i];
+            atw_v[i] = OCP_QP_IPM_MAX(atw_v[i], OCP_QP_IPM_ABS(atw[i]));
+            pv_v[i] = OCP_QP_IPM_MAX(pv_v[i], OCP_QP_IPM_ABS(Pux[i]));
+            rd_v[i] = OCP_QP_IPM_MAX(rd_v[i], OCP_QP_IPM_ABS(ri));
         }
-        for (i = c0; i < c1; i++) {
-            const hm_real ri = Pux[i] + sn->q[i] + atw[i];
+        for (i = 0; i < HM_QP_NUX; i++) {
             qv += sn->q[i] * ux[i];
             vPv += Pux[i] * ux[i];
-            atw_n = OCP_QP_IPM_MAX(atw_n, OCP_QP_IPM_ABS(atw[i]));
-            pv_n = OCP_QP_IPM_MAX(pv_n, OCP_QP_IPM_ABS(Pux[i]));
-            rd = OCP_QP_IPM_MAX(rd, OCP_QP_IPM_ABS(ri));
         }
     }
+    for (i = 0; i < HM_QP_NUX; i++) {
+        atw_n = OCP_QP_IPM_MAX(atw_n, atw_v[i]);
+        pv_n = OCP_QP_IPM_MAX(pv_n, pv_v[i]);
+        rd = OCP_QP_IPM_MAX(rd, rd_v[i]);
+    }
+    for (i = 0; i < HM_NX; i++) {
+        aveq_n = OCP_QP_IPM_MAX(aveq_n, eq_v[i]);
+        rp = OCP_QP_IPM_MAX(rp, rpe_v[i]);
+    }
+    rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_MAX(rpb_v[0], rpb_v[1]));
     sm->qv = qv;
     sm->bw = bw;
     sm->vPv = vPv;
@@ -626,17 +641,19 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
 HM_FUNC void ocp_qp_ipm_row_measures(const hm_ocp_qp_ipm_ws *restrict ws, ocp_qp_ipm_sums *restrict sm)
 {
     hm_real av = HM_R(0.0), nt = HM_R(0.0), ncr = HM_R(0.0), atw_s = HM_R(0.0), pv_s = HM_R(0.0);
+    /* bound lanes: maxima per lane (as in pass A), absent sides masked to zero */
+    hm_real avb[2] = {HM_R(0.0), HM_R(0.0)}, ntb[2] = {HM_R(0.0), HM_R(0.0)}, ncrb[2] = {HM_R(0.0), HM_R(0.0)};
     int n, k, l, j;
     for (n = 0; n <= HM_N; n++) {
         const hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
         const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
         for (k = 0; k < sn->nbp; k++) {
+            const hm_real v = sn->ux[sn->bc[k]];
             for (l = 0; l < 2; l++) {
-                const hm_real sg = sn->bsg[k][l], t = sn->bt[k][l], z = sn->bz[k][l];
-                if (sg == HM_R(0.0)) continue;
-                av = OCP_QP_IPM_MAX(av, OCP_QP_IPM_ABS(sg * sn->ux[sn->bc[k]] + t));
-                nt = OCP_QP_IPM_MAX(nt, t);
-                ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MIN(t, z));
+                const hm_real sg = sn->bsg[k][l], t = sn->bt[k][l], z = sn->bz[k][l], msk = sg * sg;
+                avb[l] = OCP_QP_IPM_MAX(avb[l], msk * OCP_QP_IPM_ABS(sg * v + t));
+                ntb[l] = OCP_QP_IPM_MAX(ntb[l], msk * t);
+                ncrb[l] = OCP_QP_IPM_MAX(ncrb[l], msk * OCP_QP_IPM_MIN(t, z));
             }
         }
         if (n == 0) continue;
@@ -655,9 +672,9 @@ HM_FUNC void ocp_qp_ipm_row_measures(const hm_ocp_qp_ipm_ws *restrict ws, ocp_qp
             ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MIN(t, z));
         }
     }
-    sm->av_ineq = av;
-    sm->nt = nt;
-    sm->ncr = ncr;
+    sm->av_ineq = OCP_QP_IPM_MAX(av, OCP_QP_IPM_MAX(avb[0], avb[1]));
+    sm->nt = OCP_QP_IPM_MAX(nt, OCP_QP_IPM_MAX(ntb[0], ntb[1]));
+    sm->ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MAX(ncrb[0], ncrb[1]));
     sm->atw_s = atw_s;
     sm->pv_s = pv_s;
 }
@@ -723,6 +740,7 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
 {
     hm_real dux[HM_QP_NUX], xn[HM_NX], dy[HM_NX];
     hm_real ratio = HM_R(0.0), tdz = HM_R(0.0), dtdz = HM_R(0.0);
+    hm_real rb[2] = {HM_R(0.0), HM_R(0.0)};   /* the bound lanes' maxima (as in pass A) */
     int n, i, j, k, l;
     for (i = 0; i < HM_QP_NUX; i++) dux[i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
@@ -748,7 +766,7 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                 const hm_real del = dt * dz;
                 sn->bdel[k][l] = del;
                 h_l[l] = sg * w * zi * del;
-                ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(-dt * ti, -dz * zi));
+                rb[l] = OCP_QP_IPM_MAX(rb[l], OCP_QP_IPM_MAX(-dt * ti, -dz * zi));
                 tdz += msk * (t * dz + z * dt);
                 dtdz += msk * del;
             }
@@ -823,7 +841,7 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         for (i = 0; i < HM_QP_NUX; i++) sn->hdl[i] = hdl[i];
         for (i = 0; i < HM_NX; i++) dux[HM_NU + i] = xn[i];
     }
-    pr->ratio = ratio;
+    pr->ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(rb[0], rb[1]));
     pr->tdz = tdz;
     pr->dtdz = dtdz;
 }
@@ -834,7 +852,7 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
                                   hm_real kdel)
 {
     hm_real dux[HM_QP_NUX], xn[HM_NX];
-    hm_real ratio = HM_R(0.0);
+    hm_real ratio = HM_R(0.0), rb[2] = {HM_R(0.0), HM_R(0.0)};
     int n, i, j, k, l;
     for (i = 0; i < HM_QP_NUX; i++) dux[i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
@@ -859,7 +877,7 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
 #endif
                 sn->bdz[k][l] = dz;
                 sn->bdt[k][l] = dt;
-                ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(-dt * ti, -dz * zi));
+                rb[l] = OCP_QP_IPM_MAX(rb[l], OCP_QP_IPM_MAX(-dt * ti, -dz * zi));
             }
         }
         if (n > 0) {
@@ -920,7 +938,7 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
         }
         for (i = 0; i < HM_NX; i++) dux[HM_NU + i] = xn[i];
     }
-    return ratio;
+    return OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(rb[0], rb[1]));
 }
 
 /* ------------------------------------------------------------------------------------------------
