@@ -182,6 +182,7 @@ typedef struct HM_NS(ocp_qp_ipm_stage) {
     HM_REAL P[HM_NX * HM_NX], p[HM_NX], Pry[HM_NX];
     HM_REAL Ld[3];                    /* LDL' of the input block: 1 / d0, l10, 1 / d1 */
     HM_REAL Kx[HM_NU * HM_NX];        /* L^-1 (input-state block), row j at Kx[j * HM_NX] */
+    HM_REAL F[HM_NX * HM_NX];         /* closed-loop dynamics A - B G of the step's feedback u = -G x + .. */
     HM_REAL yk[HM_NU];
 } HM_NS(ocp_qp_ipm_stage);
 

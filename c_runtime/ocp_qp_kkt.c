@@ -63,6 +63,24 @@ HM_FUNC int ocp_qp_kkt_input_ldl(hm_ocp_qp_ipm_stage *restrict sn, hm_real h00, 
     return 0;
 }
 
+/* The closed-loop matrix F = A - B G of stage 0 < n < HM_N, G the feedback gain of the solves
+ * (u = -G x + const): the substitutions carry p and x through F alone, one 4x4 product per stage
+ * on their sequential chain instead of the gain's dot products followed by A and B. */
+HM_FUNC void ocp_qp_kkt_closed_loop(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn, int n)
+{
+    const hm_real *restrict A = qp->A[n];
+    const hm_real *restrict B = qp->B[n];
+    const hm_real *restrict K0 = sn->Kx;
+    const hm_real *restrict K1 = sn->Kx + HM_NX;
+    const hm_real id0 = sn->Ld[0], l10 = sn->Ld[1], id1 = sn->Ld[2];
+    int i, k;
+    for (k = 0; k < HM_NX; k++) {
+        const hm_real g1 = id1 * K1[k];
+        const hm_real g0 = id0 * K0[k] - l10 * g1;
+        for (i = 0; i < HM_NX; i++) sn->F[i + k * HM_NX] = A[i + k * HM_NX] - B[i] * g0 - B[i + HM_NX] * g1;
+    }
+}
+
 /* Stage 0 < n < HM_N of the factorisation when A_n = [e_0 e_1 a_2 a_3] (the robot's dynamics: the
  * position enters no other state's update), written out: every matrix entry a scalar, the
  * symmetric ones once. Same results as the general path up to the order of the sums. */
@@ -174,6 +192,7 @@ HM_FUNC int ocp_qp_kkt_factor_stage_posfree(const hm_ocp_qp *restrict qp, hm_ocp
     Pn[13] = q31;
     Pn[14] = q32;
     Pn[15] = q33;
+    ocp_qp_kkt_closed_loop(qp, sn, n);
     return 0;
 }
 
@@ -272,6 +291,7 @@ HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_
                     Pn[j + i * HM_NX] = v;
                 }
             }
+            ocp_qp_kkt_closed_loop(qp, sn, n);
         }
     }
     return 0;
@@ -286,7 +306,6 @@ HM_FUNC void ocp_qp_kkt_backward_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_i
         return;
     }
     {
-        const hm_real *restrict A = qp->A[n];
         const hm_real *restrict B = qp->B[n];
         const hm_real *restrict L = sn->Ld;
         hm_real pb[HM_NX], y0, y1;
@@ -296,18 +315,14 @@ HM_FUNC void ocp_qp_kkt_backward_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_i
         sn->yk[0] = y0;
         sn->yk[1] = y1;
         if (n > 0) {
-            const hm_real c0 = y0 * L[0], c1 = y1 * L[2];
+            /* p = h_x + A' pb - Kx' D^-1 L^-1 (h_u + B' pb), regrouped as the part without pb plus
+             * F' pb: only the latter waits for stage n + 1 */
+            const hm_real c0 = h[0] * L[0], c1 = (h[1] - L[1] * h[0]) * L[2];
             const hm_real *restrict K0 = sn->Kx;
             const hm_real *restrict K1 = sn->Kx + HM_NX;
-            if (sn->a_id) {
-                sn->p[0] = h[HM_NU] + pb[0] - K0[0] * c0 - K1[0] * c1;
-                sn->p[1] = h[HM_NU + 1] + pb[1] - K0[1] * c0 - K1[1] * c1;
-                for (i = 2; i < HM_NX; i++)
-                    sn->p[i] = h[HM_NU + i] + ocp_qp_kkt_dot4(A + i * HM_NX, pb) - K0[i] * c0 - K1[i] * c1;
-            } else {
-                for (i = 0; i < HM_NX; i++)
-                    sn->p[i] = h[HM_NU + i] + ocp_qp_kkt_dot4(A + i * HM_NX, pb) - K0[i] * c0 - K1[i] * c1;
-            }
+            const hm_real *restrict F = sn->F;
+            for (i = 0; i < HM_NX; i++)
+                sn->p[i] = (h[HM_NU + i] - K0[i] * c0 - K1[i] * c1) + ocp_qp_kkt_dot4(F + i * HM_NX, pb);
         }
     }
 }
@@ -316,11 +331,10 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp
                                       const hm_ocp_qp_ipm_stage *restrict sn1, int n, const hm_real *restrict x,
                                       hm_real *restrict u, hm_real *restrict xn, hm_real *restrict dy)
 {
-    const hm_real *restrict A = qp->A[n];
     const hm_real *restrict B = qp->B[n];
     const hm_real *restrict L = sn->Ld;
     hm_real w0 = sn->yk[0], w1 = sn->yk[1], v0, v1, xnew[HM_NX], t[HM_NX];
-    int i, k;
+    int i;
     if (n > 0) {
         w0 += ocp_qp_kkt_dot4(sn->Kx, x);
         w1 += ocp_qp_kkt_dot4(sn->Kx + HM_NX, x);
@@ -329,16 +343,15 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp
     v0 = w0 * L[0] - L[1] * v1;
     u[0] = -v0;
     u[1] = -v1;
-    for (i = 0; i < HM_NX; i++) xnew[i] = sn->ry[i] - B[i] * v0 - B[i + HM_NX] * v1;
     if (n > 0) {
-        for (k = sn->a_id ? 2 : 0; k < HM_NX; k++) {
-            const hm_real xk = x[k];
-            for (i = 0; i < HM_NX; i++) xnew[i] += A[i + k * HM_NX] * xk;
-        }
-        if (sn->a_id) {
-            xnew[0] += x[0];
-            xnew[1] += x[1];
-        }
+        /* x_next = A x + B u + ry = F x + (ry + B u(x = 0)): the state waits on F x only */
+        const hm_real e1 = sn->yk[1] * L[2];
+        const hm_real e0 = sn->yk[0] * L[0] - L[1] * e1;
+        hm_real fx[HM_NX];
+        ocp_qp_kkt_mv4(sn->F, x, fx);
+        for (i = 0; i < HM_NX; i++) xnew[i] = (sn->ry[i] - B[i] * e0 - B[i + HM_NX] * e1) + fx[i];
+    } else {
+        for (i = 0; i < HM_NX; i++) xnew[i] = sn->ry[i] - B[i] * v0 - B[i + HM_NX] * v1;
     }
     ocp_qp_kkt_mv4(sn1->P, xnew, t);
     for (i = 0; i < HM_NX; i++) {
