@@ -76,8 +76,10 @@ typedef struct HM_NS(ocp_qp_sol) {
  * A primal-dual (infeasible-start, Mehrotra predictor-corrector) method. Its inequalities are kept
  * per stage in fixed-size blocks of three families, so that every loop has a compile-time bound or
  * visits only what is present:
- *   bound pairs   a component of (u, x) with a lower and/or an upper bound: the two sides are the
- *                 two lanes of a 2-vector (an absent side is a lane with sign 0 and a neutral state);
+ *   bound pairs   a component of (u, x) with a lower and/or an upper bound somewhere on the horizon:
+ *                 one slot per such component for all stages, stored stage-major (ocp_qp_ipm_bounds)
+ *                 so that the passes treat eight stages at once in vector lanes; a side absent at a
+ *                 stage has sign 0 and a neutral state;
  *   soft rows     D' p + s >= lg with its slack s >= 0 (s is its own slack: no second slack);
  *   hard rows     D' p >= lg.
  * Rows are processed two at a time (2-wide SIMD where the compiler can); a stage with an odd count
@@ -129,24 +131,14 @@ typedef struct HM_NS(ocp_qp_outcome) {
  * stage HM_N and x of stage 0 unused), and y_n, the multiplier of the dynamics from n to n + 1. */
 typedef struct HM_NS(ocp_qp_ipm_stage) {
     /* structure, set up by every solve */
-    int nbp;                          /* bound pairs */
     int ns, nh;                       /* soft rows, hard rows */
     int ns2, nh2;                     /* the same rounded up to even (rows go in pairs) */
     int a_id;                         /* 1: the first two columns of A_n are e_0, e_1 */
-    unsigned char bc[HM_NU + HM_NX];  /* component of ux of bound pair k */
     unsigned char srow[(HM_NG + 1) / 2 * 2];   /* QP row of soft row j */
     unsigned char hrow[(HM_NG + 1) / 2 * 2];   /* QP row of hard row j */
     /* cost times the cost scale (stage 0: x_0 terms folded into q), dynamics offset (stage 0:
      * b_0 + A_0 x_0); column-major like ocp_qp */
     HM_REAL R[HM_NU * HM_NU], S[HM_NU * HM_NX], Q[HM_NX * HM_NX], q[HM_NU + HM_NX], beq[HM_NX];
-
-    /* bound pairs, lane 0 the lower and lane 1 the upper bound: sign * ux[c] + t = b, i.e.
-     * sign -1 and b = -lb, sign +1 and b = ub; an absent side has sign 0 and b = 1 */
-    HM_REAL bsg[HM_NU + HM_NX][2], bb[HM_NU + HM_NX][2];
-    HM_REAL bt[HM_NU + HM_NX][2], bz[HM_NU + HM_NX][2];          /* slack, multiplier */
-    HM_REAL bdt[HM_NU + HM_NX][2], bdz[HM_NU + HM_NX][2];        /* step */
-    HM_REAL bw[HM_NU + HM_NX][2], bti[HM_NU + HM_NX][2], bzi[HM_NU + HM_NX][2];   /* z/t, 1/t, 1/z */
-    HM_REAL brho[HM_NU + HM_NX][2], bdel[HM_NU + HM_NX][2];      /* predictor rhs, dt_aff dz_aff */
 
     /* soft rows: -(d' p + s) + t = -lg, s >= 0; cost zl s + Zl s^2 / 2 (times the cost scale);
      * live 1, or 0 for the padding row */
@@ -185,6 +177,36 @@ typedef struct HM_NS(ocp_qp_ipm_stage) {
     HM_REAL F[HM_NX * HM_NX];         /* closed-loop dynamics A - B G of the step's feedback u = -G x + .. */
     HM_REAL yk[HM_NU];
 } HM_NS(ocp_qp_ipm_stage);
+
+/* The bound pairs of all stages, stage-major: slot k (< nbp) is component bc[k] of (u, x), side 0
+ * the lower and side 1 the upper bound, sign * ux[c] + t = b (sign -1 and b = -lb, sign +1 and
+ * b = ub; an absent side has sign 0, b = 1 and stays at t = z = 1). The stages run to HM_N + 1
+ * rounded up to a multiple of 8 (HM_QP_NNP of ocp_qp_kkt.h), those past HM_N absent on both sides. */
+typedef struct HM_NS(ocp_qp_ipm_bounds) {
+    int nbp;
+    unsigned char bc[HM_NU + HM_NX];
+    HM_REAL sg[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* sign */
+    HM_REAL b[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];
+    HM_REAL t[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];     /* slack */
+    HM_REAL z[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];     /* multiplier */
+    HM_REAL dt[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* step */
+    HM_REAL dz[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];
+    HM_REAL w[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];     /* z / t, capped */
+    HM_REAL ti[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* 1 / t */
+    HM_REAL zi[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* 1 / z */
+    HM_REAL rho[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];   /* predictor right-hand side */
+    HM_REAL del[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];   /* predictor dt dz */
+    /* per slot and stage: ux[c] of the iterate, of the step and of the predictor's step; the pair's
+     * parts of A' w, of the Newton diagonal and of the gradients ha, hmu and hdl */
+    HM_REAL v[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL dv[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL dva[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL atw[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL Hd[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL hf[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL hmu[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL hdl[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+} HM_NS(ocp_qp_ipm_bounds);
 
 /* A vector in the solver's layout (the Newton system's unknowns or right-hand side), used by the
  * general solve of ocp_qp_kkt.h (tests, polish): per stage ux, the soft slacks by soft row, y, and
@@ -276,6 +298,7 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
     union {
         struct {
             HM_NS(ocp_qp_ipm_stage) st[HM_N + 1];
+            HM_NS(ocp_qp_ipm_bounds) bd;
             HM_NS(ocp_qp_ipm_vec) va, vb;
         } f;
         HM_NS(ocp_qp_hsde_ws) hsde;

@@ -7,7 +7,9 @@
  * -(d' p + s) + t = -lg, a soft slack's bound -s + s = 0 (its slack is s itself), a hard row
  * -d' p + t = -lg.
  *
- * One iteration is five passes over the stages, each fused so that a stage's data is touched once:
+ * One iteration is five passes over the stages, each fused so that a stage's data is touched once;
+ * in passes A, C and E the bound pairs take a sweep of their own over their stage-major arrays
+ * (hm_types.h: ocp_qp_ipm_bounds), eight stages at a time in vector lanes:
  *   A (forward)   take the last step, evaluate the residuals, the weights z / t, and condense the
  *                 inequalities into their stage: Hessian terms (Hd, Hpp), the predictor's gradient
  *                 (ha) and the gradient per unit of sigma mu (hmu); termination measures.
@@ -126,44 +128,81 @@ HM_FUNC const char *ocp_qp_status_message(int status)
 
 /* Builds the stage blocks of qp and the starting point. Returns HM_QP_INFEASIBLE if a lower bound
  * exceeds its upper bound; *bad = stage * HM_QP_NUX + component. */
+/* The bounds of component i of (u, x) at stage n (n <= HM_N); 0 if the stage has no such component
+ * (u at stage HM_N, x at stage 0: not part of the problem). */
+HM_FUNC int ocp_qp_ipm_bounds_of(const hm_ocp_qp *qp, int n, int i, hm_real *lb, hm_real *ub)
+{
+    if (i < HM_NU) {
+        if (n == HM_N) return 0;
+        *lb = qp->lbu[n][i];
+        *ub = qp->ubu[n][i];
+    } else {
+        if (n == 0) return 0;
+        *lb = qp->lbx[n][i - HM_NU];
+        *ub = qp->ubx[n][i - HM_NU];
+    }
+    return 1;
+}
+
 HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad)
 {
-    int n, i, j, k, m = 0;
+    hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    int n, i, j, k, l, m = 0;
+    int bounded[HM_QP_NUX];
     hm_real norm_q = HM_R(0.0), norm_b = HM_R(0.0), hscale = HM_R(0.0), c;
 
+    /* bound pairs: a slot for every component bounded at some stage (crossing bounds, found in
+     * stage order, make the QP infeasible), its sides per stage; the starting point t = max(b, 1),
+     * z = 1 / t; a side absent at a stage keeps sign 0, b = t = z = 1 */
+    for (i = 0; i < HM_QP_NUX; i++) bounded[i] = 0;
     for (n = 0; n <= HM_N; n++) {
-        hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
-        int nbp = 0, ns = 0, nh = 0;
-        /* bound pairs */
         for (i = 0; i < HM_QP_NUX; i++) {
-            hm_real lb, ub;
+            hm_real lb = HM_R(0.0), ub = HM_R(0.0);
             int lp, up;
-            if (i < HM_NU) {
-                if (n == HM_N) continue;
-                lb = qp->lbu[n][i];
-                ub = qp->ubu[n][i];
-            } else {
-                if (n == 0) continue;
-                lb = qp->lbx[n][i - HM_NU];
-                ub = qp->ubx[n][i - HM_NU];
-            }
+            if (!ocp_qp_ipm_bounds_of(qp, n, i, &lb, &ub)) continue;
             lp = ocp_qp_bound_present(lb);
             up = ocp_qp_bound_present(ub);
-            if (!lp && !up) continue;
             if (lp && up && lb > ub) {
                 *bad = n * HM_QP_NUX + i;
                 return HM_QP_INFEASIBLE;
             }
-            sn->bc[nbp] = (unsigned char)i;
-            sn->bsg[nbp][0] = lp ? HM_R(-1.0) : HM_R(0.0);
-            sn->bsg[nbp][1] = up ? HM_R(1.0) : HM_R(0.0);
-            sn->bb[nbp][0] = lp ? -lb : HM_R(1.0);
-            sn->bb[nbp][1] = up ? ub : HM_R(1.0);
+            if (lp || up) bounded[i] = 1;
+        }
+    }
+    bd->nbp = 0;
+    for (i = 0; i < HM_QP_NUX; i++) {
+        if (bounded[i]) bd->bc[bd->nbp++] = (unsigned char)i;
+    }
+    for (k = 0; k < bd->nbp; k++) {
+        const int comp = bd->bc[k];
+        for (n = 0; n < HM_QP_NNP; n++) {
+            hm_real lb = -HM_INF, ub = HM_INF;
+            int lp = 0, up = 0;
+            if (n <= HM_N && ocp_qp_ipm_bounds_of(qp, n, comp, &lb, &ub)) {
+                lp = ocp_qp_bound_present(lb);
+                up = ocp_qp_bound_present(ub);
+            }
+            bd->sg[k][0][n] = lp ? HM_R(-1.0) : HM_R(0.0);
+            bd->sg[k][1][n] = up ? HM_R(1.0) : HM_R(0.0);
+            bd->b[k][0][n] = lp ? -lb : HM_R(1.0);
+            bd->b[k][1][n] = up ? ub : HM_R(1.0);
             if (lp) norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(lb));
             if (up) norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(ub));
             m += lp + up;
-            nbp++;
+            for (l = 0; l < 2; l++) {
+                const hm_real t = bd->sg[k][l][n] != HM_R(0.0) ? OCP_QP_IPM_MAX(bd->b[k][l][n], HM_R(1.0)) : HM_R(1.0);
+                bd->t[k][l][n] = t;
+                bd->z[k][l][n] = bd->sg[k][l][n] != HM_R(0.0) ? HM_R(1.0) / t : HM_R(1.0);
+                bd->dt[k][l][n] = HM_R(0.0);
+                bd->dz[k][l][n] = HM_R(0.0);
+            }
+            bd->v[k][n] = bd->dv[k][n] = bd->dva[k][n] = HM_R(0.0);
         }
+    }
+
+    for (n = 0; n <= HM_N; n++) {
+        hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        int ns = 0, nh = 0;
         /* general rows: soft ones and hard ones, each in QP order */
         if (n > 0) {
             for (i = 0; i < qp->ng[n]; i++) {
@@ -191,7 +230,6 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
                 }
             }
         }
-        sn->nbp = nbp;
         sn->ns = ns;
         sn->nh = nh;
         sn->ns2 = ns + (ns & 1);
@@ -266,16 +304,6 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
             sn->y[i] = HM_R(0.0);
             sn->dy[i] = HM_R(0.0);
         }
-        for (k = 0; k < sn->nbp; k++) {
-            int l;
-            for (l = 0; l < 2; l++) {
-                const hm_real t = sn->bsg[k][l] != HM_R(0.0) ? OCP_QP_IPM_MAX(sn->bb[k][l], HM_R(1.0)) : HM_R(1.0);
-                sn->bt[k][l] = t;
-                sn->bz[k][l] = sn->bsg[k][l] != HM_R(0.0) ? HM_R(1.0) / t : HM_R(1.0);
-                sn->bdt[k][l] = HM_R(0.0);
-                sn->bdz[k][l] = HM_R(0.0);
-            }
-        }
         for (j = 0; j < sn->ns; j++) {
             const hm_real s = OCP_QP_IPM_MAX(HM_R(0.0), sn->slg[j]) + HM_R(1.0);
             const hm_real t = OCP_QP_IPM_MAX(s - sn->slg[j], HM_R(1.0));
@@ -311,6 +339,113 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         for (j = 0; j < sn->nh2; j++) sn->hdt[j] = sn->hdz[j] = HM_R(0.0);
     }
     return 0;
+}
+
+/* ------------------------------------------------------------------------------------------------
+ * Bound pairs, one side of one slot over all stages at once (ocp_qp_ipm_bounds). Functions of their
+ * own so that the arrays are restrict parameters: the compiler then runs the stages in vector lanes.
+ * ---------------------------------------------------------------------------------------------- */
+
+/* Pass A: the step, the weights and the side's parts of A' w, of the diagonal and the gradients;
+ * per stage t z, b z and the residual |rho + t|. */
+HM_FUNC void ocp_qp_ipm_bound_side_a(hm_real alpha, hm_real wmax, const hm_real *restrict sg,
+                                     const hm_real *restrict b, const hm_real *restrict v,
+                                     const hm_real *restrict dt, const hm_real *restrict dz, hm_real *restrict t,
+                                     hm_real *restrict z, hm_real *restrict w, hm_real *restrict ti,
+                                     hm_real *restrict zi, hm_real *restrict rho, hm_real *restrict atw,
+                                     hm_real *restrict Hd, hm_real *restrict hf, hm_real *restrict hmu,
+                                     hm_real *restrict tz, hm_real *restrict bw, hm_real *restrict rp)
+{
+    int n;
+    for (n = 0; n < HM_QP_NNP; n++) {
+        const hm_real s = sg[n];
+        const hm_real msk = s * s;
+        const hm_real tn = msk * (t[n] + alpha * dt[n]) + (HM_R(1.0) - msk);
+        const hm_real zn = msk * (z[n] + alpha * dz[n]) + (HM_R(1.0) - msk);
+        const hm_real r = s * v[n] - b[n];
+        const hm_real inv = HM_R(1.0) / (tn * zn);
+        const hm_real tin = zn * inv, zin = tn * inv;
+        const hm_real wn = OCP_QP_IPM_MIN(zn * tin, wmax);
+        t[n] = tn;
+        z[n] = zn;
+        w[n] = wn;
+        ti[n] = tin;
+        zi[n] = zin;
+        rho[n] = r;
+        atw[n] += s * zn;
+        Hd[n] += msk * wn;
+        hf[n] += s * wn * r;
+        hmu[n] += s * wn * zin;
+        tz[n] += msk * tn * zn;
+        rp[n] = OCP_QP_IPM_MAX(rp[n], OCP_QP_IPM_ABS(r + tn));
+        bw[n] += msk * b[n] * zn;
+    }
+}
+
+/* Pass C: the predictor's steps from the (u, x) step dv, their products dt dz (kept in del), the
+ * side's part of hdl, and per stage the step ratio, t dz + z dt and dt dz. */
+HM_FUNC void ocp_qp_ipm_bound_side_c(const hm_real *restrict sg, const hm_real *restrict t,
+                                     const hm_real *restrict z, const hm_real *restrict w,
+                                     const hm_real *restrict ti, const hm_real *restrict zi,
+                                     const hm_real *restrict rho, const hm_real *restrict dv,
+                                     hm_real *restrict del, hm_real *restrict hdl, hm_real *restrict ratio,
+                                     hm_real *restrict tdz, hm_real *restrict dtdz)
+{
+    int n;
+    for (n = 0; n < HM_QP_NNP; n++) {
+        const hm_real s = sg[n], msk = s * s;
+        const hm_real dzn = w[n] * (s * dv[n] + rho[n]);
+#ifdef OCP_QP_IPM_DT_PRIMAL
+        const hm_real dtn = -(rho[n] + t[n]) - s * dv[n];
+#else
+        const hm_real dtn = -t[n] - t[n] * dzn * zi[n];
+#endif
+        const hm_real d = dtn * dzn;
+        del[n] = d;
+        hdl[n] -= s * w[n] * zi[n] * d;
+        ratio[n] = OCP_QP_IPM_MAX(ratio[n], OCP_QP_IPM_MAX(-dtn * ti[n], -dzn * zi[n]));
+        tdz[n] += msk * (t[n] * dzn + z[n] * dtn);
+        dtdz[n] += msk * d;
+    }
+}
+
+/* Pass E: the corrector's steps (target smu, second-order term kdel * del) and the step ratio. */
+HM_FUNC void ocp_qp_ipm_bound_side_e(hm_real smu, hm_real kdel, const hm_real *restrict sg,
+                                     const hm_real *restrict t, const hm_real *restrict z,
+                                     const hm_real *restrict w, const hm_real *restrict ti,
+                                     const hm_real *restrict zi, const hm_real *restrict rho,
+                                     const hm_real *restrict del, const hm_real *restrict dv, hm_real *restrict dt,
+                                     hm_real *restrict dz, hm_real *restrict ratio)
+{
+    int n;
+    for (n = 0; n < HM_QP_NNP; n++) {
+        const hm_real s = sg[n];
+        const hm_real cc = smu - kdel * del[n];
+        const hm_real dzn = w[n] * (s * dv[n] + rho[n] + cc * zi[n]);
+#ifdef OCP_QP_IPM_DT_PRIMAL
+        const hm_real dtn = -(rho[n] + t[n]) - s * dv[n];
+        (void)z;
+#else
+        const hm_real dtn = -(t[n] * z[n] - cc + t[n] * dzn) * zi[n];
+#endif
+        dz[n] = dzn;
+        dt[n] = dtn;
+        ratio[n] = OCP_QP_IPM_MAX(ratio[n], OCP_QP_IPM_MAX(-dtn * ti[n], -dzn * zi[n]));
+    }
+}
+
+/* The termination tests' measures: per stage |A_I v + t|, t and min(t, z) of the present sides. */
+HM_FUNC void ocp_qp_ipm_bound_side_measures(const hm_real *restrict sg, const hm_real *restrict t,
+                                            const hm_real *restrict z, const hm_real *restrict v,
+                                            hm_real *restrict av, hm_real *restrict nt, hm_real *restrict ncr)
+{
+    int n;
+    for (n = 0; n < HM_QP_NNP; n++) {
+        const hm_real s = sg[n], msk = s * s;
+        av[n] = OCP_QP_IPM_MAX(av[n], msk * OCP_QP_IPM_ABS(s * v[n] + t[n]));
+        nt[n] = OCP_QP_IPM_MAX(nt[n], msk * t[n]);
+        ncr[n] = OCP_QP_IPM_MAX(ncr[n], msk * OCP_QP_IPM_MIN(t[n], z[n]));
+    }
 }
 
 /* ------------------------------------------------------------------------------------------------
@@ -366,12 +501,41 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
     hm_real rd = HM_R(0.0), rp = HM_R(0.0);
     /* The maxima are taken entry by entry across the stages and reduced at the end: the same
      * numbers (max is exact in any order), in vector lanes instead of one scalar chain. */
-    hm_real rd_v[HM_QP_NUX], pv_v[HM_QP_NUX], atw_v[HM_QP_NUX], eq_v[HM_NX], rpe_v[HM_NX], rpb_v[2];
+    hm_real rd_v[HM_QP_NUX], pv_v[HM_QP_NUX], atw_v[HM_QP_NUX], eq_v[HM_NX], rpe_v[HM_NX];
+    hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     int n, i, j, k, l;
 
     for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = pv_v[i] = atw_v[i] = HM_R(0.0);
     for (i = 0; i < HM_NX; i++) eq_v[i] = rpe_v[i] = HM_R(0.0);
-    rpb_v[0] = rpb_v[1] = HM_R(0.0);
+
+    /* bound pairs, all stages of a slot at once (an absent side has sign 0 and stays at t = z = 1);
+     * their parts of A' w, of the diagonal and of the gradients go to the stage loop below */
+    {
+        hm_real tz_v[HM_QP_NNP], bw_v[HM_QP_NNP], rp_v[HM_QP_NNP];
+        for (n = 0; n < HM_QP_NNP; n++) tz_v[n] = bw_v[n] = rp_v[n] = HM_R(0.0);
+        for (k = 0; k < bd->nbp; k++) {
+            hm_real *restrict v = bd->v[k];
+            const hm_real *restrict dv = bd->dv[k];
+            hm_real *restrict atw_b = bd->atw[k];
+            hm_real *restrict Hd_b = bd->Hd[k];
+            hm_real *restrict hf_b = bd->hf[k];
+            hm_real *restrict hmu_b = bd->hmu[k];
+            for (n = 0; n < HM_QP_NNP; n++) {
+                v[n] += alpha * dv[n];
+                atw_b[n] = Hd_b[n] = hf_b[n] = hmu_b[n] = HM_R(0.0);
+            }
+            for (l = 0; l < 2; l++)
+                ocp_qp_ipm_bound_side_a(alpha, wmax, bd->sg[k][l], bd->b[k][l], v, bd->dt[k][l], bd->dz[k][l],
+                                        bd->t[k][l], bd->z[k][l], bd->w[k][l], bd->ti[k][l], bd->zi[k][l],
+                                        bd->rho[k][l], atw_b, Hd_b, hf_b, hmu_b, tz_v, bw_v, rp_v);
+        }
+        for (n = 0; n < HM_QP_NNP; n++) {
+            tz += tz_v[n];
+            bw += bw_v[n];
+            rp = OCP_QP_IPM_MAX(rp, rp_v[n]);
+        }
+    }
+
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
         hm_real *restrict ux = sn->ux;
@@ -448,39 +612,13 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             Hd[i] = HM_R(0.0);
         }
 
-        /* bound pairs: the two sides as two lanes (an absent side has sign 0 and stays at t = z = 1) */
-        for (k = 0; k < sn->nbp; k++) {
-            const int c = sn->bc[k];
-            const hm_real v = ux[c];
-            hm_real a_l[2], h_l[2], hf_l[2], mu_l[2];
-            for (l = 0; l < 2; l++) {
-                const hm_real sg = sn->bsg[k][l];
-                const hm_real msk = sg * sg;
-                const hm_real t = msk * (sn->bt[k][l] + alpha * sn->bdt[k][l]) + (HM_R(1.0) - msk);
-                const hm_real z = msk * (sn->bz[k][l] + alpha * sn->bdz[k][l]) + (HM_R(1.0) - msk);
-                const hm_real b = sn->bb[k][l];
-                const hm_real rho = sg * v - b;
-                const hm_real inv = HM_R(1.0) / (t * z);
-                const hm_real ti = z * inv, zi = t * inv;
-                const hm_real w = OCP_QP_IPM_MIN(z * ti, wmax);
-                sn->bt[k][l] = t;
-                sn->bz[k][l] = z;
-                sn->bw[k][l] = w;
-                sn->bti[k][l] = ti;
-                sn->bzi[k][l] = zi;
-                sn->brho[k][l] = rho;
-                a_l[l] = sg * z;
-                h_l[l] = msk * w;
-                hf_l[l] = sg * w * rho;
-                mu_l[l] = sg * w * zi;
-                tz += msk * t * z;
-                rpb_v[l] = OCP_QP_IPM_MAX(rpb_v[l], OCP_QP_IPM_ABS(rho + t));
-                bw += msk * b * z;
-            }
-            atw[c] += a_l[0] + a_l[1];
-            Hd[c] += h_l[0] + h_l[1];
-            hf[c] += hf_l[0] + hf_l[1];
-            hmu[c] += mu_l[0] + mu_l[1];
+        /* bound pairs (above) */
+        for (k = 0; k < bd->nbp; k++) {
+            const int c = bd->bc[k];
+            atw[c] += bd->atw[k][n];
+            Hd[c] += bd->Hd[k][n];
+            hf[c] += bd->hf[k][n];
+            hmu[c] += bd->hmu[k][n];
         }
 
         if (n > 0) {
@@ -621,7 +759,6 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         aveq_n = OCP_QP_IPM_MAX(aveq_n, eq_v[i]);
         rp = OCP_QP_IPM_MAX(rp, rpe_v[i]);
     }
-    rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_MAX(rpb_v[0], rpb_v[1]));
     sm->qv = qv;
     sm->bw = bw;
     sm->vPv = vPv;
@@ -642,20 +779,22 @@ HM_FUNC void ocp_qp_ipm_row_measures(const hm_ocp_qp_ipm_ws *restrict ws, ocp_qp
 {
     hm_real av = HM_R(0.0), nt = HM_R(0.0), ncr = HM_R(0.0), atw_s = HM_R(0.0), pv_s = HM_R(0.0);
     /* bound lanes: maxima per lane (as in pass A), absent sides masked to zero */
-    hm_real avb[2] = {HM_R(0.0), HM_R(0.0)}, ntb[2] = {HM_R(0.0), HM_R(0.0)}, ncrb[2] = {HM_R(0.0), HM_R(0.0)};
+    hm_real avb[HM_QP_NNP], ntb[HM_QP_NNP], ncrb[HM_QP_NNP];
+    const hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     int n, k, l, j;
+    for (n = 0; n < HM_QP_NNP; n++) avb[n] = ntb[n] = ncrb[n] = HM_R(0.0);
+    for (k = 0; k < bd->nbp; k++) {
+        for (l = 0; l < 2; l++)
+            ocp_qp_ipm_bound_side_measures(bd->sg[k][l], bd->t[k][l], bd->z[k][l], bd->v[k], avb, ntb, ncrb);
+    }
+    for (n = 0; n < HM_QP_NNP; n++) {
+        av = OCP_QP_IPM_MAX(av, avb[n]);
+        nt = OCP_QP_IPM_MAX(nt, ntb[n]);
+        ncr = OCP_QP_IPM_MAX(ncr, ncrb[n]);
+    }
     for (n = 0; n <= HM_N; n++) {
         const hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
         const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
-        for (k = 0; k < sn->nbp; k++) {
-            const hm_real v = sn->ux[sn->bc[k]];
-            for (l = 0; l < 2; l++) {
-                const hm_real sg = sn->bsg[k][l], t = sn->bt[k][l], z = sn->bz[k][l], msk = sg * sg;
-                avb[l] = OCP_QP_IPM_MAX(avb[l], msk * OCP_QP_IPM_ABS(sg * v + t));
-                ntb[l] = OCP_QP_IPM_MAX(ntb[l], msk * t);
-                ncrb[l] = OCP_QP_IPM_MAX(ncrb[l], msk * OCP_QP_IPM_MIN(t, z));
-            }
-        }
         if (n == 0) continue;
         for (j = 0; j < sn->ns; j++) {
             const hm_real t = sn->st[j], z = sn->sz[j], s = sn->ss[j], zs = sn->szs[j];
@@ -672,9 +811,9 @@ HM_FUNC void ocp_qp_ipm_row_measures(const hm_ocp_qp_ipm_ws *restrict ws, ocp_qp
             ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MIN(t, z));
         }
     }
-    sm->av_ineq = OCP_QP_IPM_MAX(av, OCP_QP_IPM_MAX(avb[0], avb[1]));
-    sm->nt = OCP_QP_IPM_MAX(nt, OCP_QP_IPM_MAX(ntb[0], ntb[1]));
-    sm->ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MAX(ncrb[0], ncrb[1]));
+    sm->av_ineq = av;
+    sm->nt = nt;
+    sm->ncr = ncr;
     sm->atw_s = atw_s;
     sm->pv_s = pv_s;
 }
@@ -740,7 +879,7 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
 {
     hm_real dux[HM_QP_NUX], xn[HM_NX], dy[HM_NX];
     hm_real ratio = HM_R(0.0), tdz = HM_R(0.0), dtdz = HM_R(0.0);
-    hm_real rb[2] = {HM_R(0.0), HM_R(0.0)};   /* the bound lanes' maxima (as in pass A) */
+    hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     int n, i, j, k, l;
     for (i = 0; i < HM_QP_NUX; i++) dux[i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
@@ -748,30 +887,7 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         hm_real hdl[HM_QP_NUX];
         ocp_qp_ipm_stage_step(qp, ws, n, dux, xn, dy);
         for (i = 0; i < HM_QP_NUX; i++) hdl[i] = HM_R(0.0);
-
-        for (k = 0; k < sn->nbp; k++) {
-            const int c = sn->bc[k];
-            const hm_real dv = dux[c];
-            hm_real h_l[2];
-            for (l = 0; l < 2; l++) {
-                const hm_real sg = sn->bsg[k][l], msk = sg * sg;
-                const hm_real t = sn->bt[k][l], z = sn->bz[k][l], w = sn->bw[k][l];
-                const hm_real ti = sn->bti[k][l], zi = sn->bzi[k][l];
-                const hm_real dz = w * (sg * dv + sn->brho[k][l]);
-#ifdef OCP_QP_IPM_DT_PRIMAL
-                const hm_real dt = -(sn->brho[k][l] + t) - sg * dv;
-#else
-                const hm_real dt = -t - t * dz * zi;
-#endif
-                const hm_real del = dt * dz;
-                sn->bdel[k][l] = del;
-                h_l[l] = sg * w * zi * del;
-                rb[l] = OCP_QP_IPM_MAX(rb[l], OCP_QP_IPM_MAX(-dt * ti, -dz * zi));
-                tdz += msk * (t * dz + z * dt);
-                dtdz += msk * del;
-            }
-            hdl[c] -= h_l[0] + h_l[1];
-        }
+        for (k = 0; k < bd->nbp; k++) bd->dva[k][n] = dux[bd->bc[k]];
         if (n > 0) {
             const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
             const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
@@ -841,7 +957,30 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         for (i = 0; i < HM_QP_NUX; i++) sn->hdl[i] = hdl[i];
         for (i = 0; i < HM_NX; i++) dux[HM_NU + i] = xn[i];
     }
-    pr->ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(rb[0], rb[1]));
+    /* bound pairs, all stages of a slot at once */
+    {
+        hm_real r_v[HM_QP_NNP], tdz_v[HM_QP_NNP], dtdz_v[HM_QP_NNP];
+        for (n = 0; n < HM_QP_NNP; n++) r_v[n] = tdz_v[n] = dtdz_v[n] = HM_R(0.0);
+        for (k = 0; k < bd->nbp; k++) {
+            const hm_real *restrict dvp = bd->dva[k];
+            hm_real *restrict hdl_b = bd->hdl[k];
+            for (n = 0; n < HM_QP_NNP; n++) hdl_b[n] = HM_R(0.0);
+            for (l = 0; l < 2; l++)
+                ocp_qp_ipm_bound_side_c(bd->sg[k][l], bd->t[k][l], bd->z[k][l], bd->w[k][l], bd->ti[k][l],
+                                        bd->zi[k][l], bd->rho[k][l], dvp, bd->del[k][l], hdl_b, r_v, tdz_v, dtdz_v);
+        }
+        for (n = 0; n < HM_QP_NNP; n++) {
+            ratio = OCP_QP_IPM_MAX(ratio, r_v[n]);
+            tdz += tdz_v[n];
+            dtdz += dtdz_v[n];
+        }
+        /* into the stages' hdl, which pass D reads (off its sequential chain here) */
+        for (n = 0; n <= HM_N; n++) {
+            hm_real *restrict hdl = ws->u.f.st[n].hdl;
+            for (k = 0; k < bd->nbp; k++) hdl[bd->bc[k]] += bd->hdl[k][n];
+        }
+    }
+    pr->ratio = ratio;
     pr->tdz = tdz;
     pr->dtdz = dtdz;
 }
@@ -852,34 +991,15 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
                                   hm_real kdel)
 {
     hm_real dux[HM_QP_NUX], xn[HM_NX];
-    hm_real ratio = HM_R(0.0), rb[2] = {HM_R(0.0), HM_R(0.0)};
+    hm_real ratio = HM_R(0.0);
+    hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     int n, i, j, k, l;
     for (i = 0; i < HM_QP_NUX; i++) dux[i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
         ocp_qp_ipm_stage_step(qp, ws, n, dux, xn, sn->dy);
         for (i = 0; i < HM_QP_NUX; i++) sn->dux[i] = dux[i];
-
-        for (k = 0; k < sn->nbp; k++) {
-            const int c = sn->bc[k];
-            const hm_real dv = dux[c];
-            for (l = 0; l < 2; l++) {
-                const hm_real sg = sn->bsg[k][l];
-                const hm_real t = sn->bt[k][l], z = sn->bz[k][l], w = sn->bw[k][l];
-                const hm_real ti = sn->bti[k][l], zi = sn->bzi[k][l], del = sn->bdel[k][l];
-                const hm_real cc = smu - kdel * del;
-                const hm_real dz = w * (sg * dv + sn->brho[k][l] + cc * zi);
-#ifdef OCP_QP_IPM_DT_PRIMAL
-                const hm_real dt = -(sn->brho[k][l] + t) - sg * dv;
-                (void)z;
-#else
-                const hm_real dt = -(t * z - cc + t * dz) * zi;
-#endif
-                sn->bdz[k][l] = dz;
-                sn->bdt[k][l] = dt;
-                rb[l] = OCP_QP_IPM_MAX(rb[l], OCP_QP_IPM_MAX(-dt * ti, -dz * zi));
-            }
-        }
+        for (k = 0; k < bd->nbp; k++) bd->dv[k][n] = dux[bd->bc[k]];
         if (n > 0) {
             const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
             const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
@@ -938,7 +1058,20 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
         }
         for (i = 0; i < HM_NX; i++) dux[HM_NU + i] = xn[i];
     }
-    return OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(rb[0], rb[1]));
+    /* bound pairs, all stages of a slot at once */
+    {
+        hm_real r_v[HM_QP_NNP];
+        for (n = 0; n < HM_QP_NNP; n++) r_v[n] = HM_R(0.0);
+        for (k = 0; k < bd->nbp; k++) {
+            const hm_real *restrict dvp = bd->dv[k];
+            for (l = 0; l < 2; l++)
+                ocp_qp_ipm_bound_side_e(smu, kdel, bd->sg[k][l], bd->t[k][l], bd->z[k][l], bd->w[k][l], bd->ti[k][l],
+                                        bd->zi[k][l], bd->rho[k][l], bd->del[k][l], dvp, bd->dt[k][l], bd->dz[k][l],
+                                        r_v);
+        }
+        for (n = 0; n < HM_QP_NNP; n++) ratio = OCP_QP_IPM_MAX(ratio, r_v[n]);
+    }
+    return ratio;
 }
 
 /* ------------------------------------------------------------------------------------------------
@@ -947,7 +1080,8 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
 
 /* Multipliers and slacks of stage n into sol from the given inequality values (stage blocks or a
  * vector); sc scales the multipliers, sp the slacks. */
-HM_FUNC void ocp_qp_ipm_write_stage(const hm_ocp_qp_ipm_stage *sn, int n, hm_ocp_qp_sol *sol,
+HM_FUNC void ocp_qp_ipm_write_stage(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd, int n,
+                                    hm_ocp_qp_sol *sol,
                                     const hm_real (*zb)[2], const hm_real *s, const hm_real *zr,
                                     const hm_real *zs, const hm_real *zh, hm_real sc, hm_real sp)
 {
@@ -967,11 +1101,12 @@ HM_FUNC void ocp_qp_ipm_write_stage(const hm_ocp_qp_ipm_stage *sn, int n, hm_ocp
             sol->lam_ubu[n][i] = HM_R(0.0);
         }
     }
-    for (k = 0; k < sn->nbp; k++) {
-        const int c = sn->bc[k];
+    for (k = 0; k < bd->nbp; k++) {
+        const int c = bd->bc[k];
         /* an absent side has sign 0: its multiplier is written as 0 */
-        const hm_real lo = sc * sn->bsg[k][0] * sn->bsg[k][0] * zb[k][0];
-        const hm_real up = sc * sn->bsg[k][1] * sn->bsg[k][1] * zb[k][1];
+        const hm_real lo = sc * bd->sg[k][0][n] * bd->sg[k][0][n] * zb[k][0];
+        const hm_real up = sc * bd->sg[k][1][n] * bd->sg[k][1][n] * zb[k][1];
+        if (c < HM_NU ? n == HM_N : n == 0) continue;   /* the slot's component is not part of stage n */
         if (c < HM_NU) {
             sol->lam_lbu[n][c] = lo;
             sol->lam_ubu[n][c] = up;
@@ -1005,7 +1140,14 @@ HM_FUNC void ocp_qp_ipm_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *w
         if (n > 0) {
             for (i = 0; i < HM_NX; i++) sol->x[n][i] = sp * sn->ux[HM_NU + i];
         }
-        ocp_qp_ipm_write_stage(sn, n, sol, (const hm_real (*)[2])sn->bz, sn->ss, sn->sz, sn->szs, sn->hz, sc, sp);
+        hm_real zb[HM_QP_NUX][2];
+        int k;
+        for (k = 0; k < ws->u.f.bd.nbp; k++) {
+            zb[k][0] = ws->u.f.bd.z[k][0][n];
+            zb[k][1] = ws->u.f.bd.z[k][1][n];
+        }
+        ocp_qp_ipm_write_stage(sn, &ws->u.f.bd, n, sol, (const hm_real (*)[2])zb, sn->ss, sn->sz, sn->szs, sn->hz,
+                               sc, sp);
     }
 }
 
@@ -1023,8 +1165,8 @@ HM_FUNC void ocp_qp_ipm_write_sol_vec(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_w
         if (n > 0) {
             for (i = 0; i < HM_NX; i++) sol->x[n][i] = v->ux[n][HM_NU + i];
         }
-        ocp_qp_ipm_write_stage(&ws->u.f.st[n], n, sol, (const hm_real (*)[2])v->zb[n], v->s[n], v->zr[n], v->zs[n],
-                               v->zh[n], sc, HM_R(1.0));
+        ocp_qp_ipm_write_stage(&ws->u.f.st[n], &ws->u.f.bd, n, sol, (const hm_real (*)[2])v->zb[n], v->s[n], v->zr[n],
+                               v->zs[n], v->zh[n], sc, HM_R(1.0));
     }
 }
 
@@ -1033,6 +1175,7 @@ HM_FUNC void ocp_qp_ipm_write_sol_vec(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_w
 HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_vec *w,
                               hm_real tol_infeas, hm_real *bw_out)
 {
+    const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     hm_real bw = HM_R(0.0), atw_n = HM_R(0.0);
     int n, i, k, j, l;
     for (n = 0; n <= HM_N; n++) {
@@ -1052,11 +1195,11 @@ HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, c
         if (n > 0) {
             for (i = 0; i < HM_NX; i++) atw[HM_NU + i] += w->y[n - 1][i];
         }
-        for (k = 0; k < sn->nbp; k++) {
+        for (k = 0; k < bd->nbp; k++) {
             for (l = 0; l < 2; l++) {
-                const hm_real sg = sn->bsg[k][l];
-                atw[sn->bc[k]] += sg * w->zb[n][k][l];
-                bw += sg * sg * sn->bb[k][l] * w->zb[n][k][l];
+                const hm_real sg = bd->sg[k][l][n];
+                atw[bd->bc[k]] += sg * w->zb[n][k][l];
+                bw += sg * sg * bd->b[k][l][n] * w->zb[n][k][l];
             }
         }
         for (j = 0; j < sn->ns; j++) {
@@ -1082,6 +1225,7 @@ HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, c
  * of the data. Along such a d every feasible point can be improved without bound. */
 HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, hm_real tol_infeas)
 {
+    const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     const hm_real cinv = HM_R(1.0) / ws->cost_scale;
     hm_real qd = HM_R(0.0), pd = HM_R(0.0), ad = HM_R(0.0);
     int n, i, k, j, l;
@@ -1108,8 +1252,8 @@ HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws
                 ad = OCP_QP_IPM_MAX(ad, OCP_QP_IPM_ABS(e));
             }
         }
-        for (k = 0; k < sn->nbp; k++) {
-            for (l = 0; l < 2; l++) ad = OCP_QP_IPM_MAX(ad, sn->bsg[k][l] * d[sn->bc[k]]);
+        for (k = 0; k < bd->nbp; k++) {
+            for (l = 0; l < 2; l++) ad = OCP_QP_IPM_MAX(ad, bd->sg[k][l][n] * d[bd->bc[k]]);
         }
         for (j = 0; j < sn->ns; j++) {
             const hm_real gd = sn->sd0[j] * d[HM_NU] + sn->sd1[j] * d[HM_NU + 1];
@@ -1127,6 +1271,7 @@ HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws
  * less of the bounded part that the iterate carries. */
 HM_FUNC void ocp_qp_ipm_ray_from_step(hm_ocp_qp_ipm_ws *ws)
 {
+    const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     hm_ocp_qp_ipm_vec *v = &ws->u.f.va;
     int n, i, k, j, l;
     for (n = 0; n <= HM_N; n++) {
@@ -1135,8 +1280,8 @@ HM_FUNC void ocp_qp_ipm_ray_from_step(hm_ocp_qp_ipm_ws *ws)
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) v->y[n][i] = sn->dy[i];
         }
-        for (k = 0; k < sn->nbp; k++) {
-            for (l = 0; l < 2; l++) v->zb[n][k][l] = OCP_QP_IPM_MAX(sn->bdz[k][l], HM_R(0.0));
+        for (k = 0; k < bd->nbp; k++) {
+            for (l = 0; l < 2; l++) v->zb[n][k][l] = OCP_QP_IPM_MAX(bd->dz[k][l][n], HM_R(0.0));
         }
         for (j = 0; j < sn->ns; j++) {
             v->s[n][j] = HM_R(0.0);
@@ -1158,6 +1303,7 @@ HM_FUNC void ocp_qp_ipm_ray_from_step(hm_ocp_qp_ipm_ws *ws)
 HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws,
                                         const hm_ocp_qp_ipm_vec *d, hm_ocp_qp_ipm_vec *e)
 {
+    const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     const hm_real wmax = ws->w_max;
     int n, i, k, j, l;
     for (n = 0; n <= HM_N; n++) {
@@ -1187,13 +1333,13 @@ HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm
         if (n > 0) {
             for (i = 0; i < HM_NX; i++) r[HM_NU + i] += d->y[n - 1][i];
         }
-        for (k = 0; k < sn->nbp; k++) {
-            const int c = sn->bc[k];
+        for (k = 0; k < bd->nbp; k++) {
+            const int c = bd->bc[k];
             for (l = 0; l < 2; l++) {
-                const hm_real w = sn->bw[k][l];
+                const hm_real w = bd->w[k][l][n];
                 const hm_real t = w < wmax ? -d->zb[n][k][l] / w : HM_R(0.0);
-                r[c] += sn->bsg[k][l] * d->zb[n][k][l];
-                e->zb[n][k][l] = -(sn->bsg[k][l] * ux[c] + t - sn->bb[k][l]);
+                r[c] += bd->sg[k][l][n] * d->zb[n][k][l];
+                e->zb[n][k][l] = -(bd->sg[k][l][n] * ux[c] + t - bd->b[k][l][n]);
             }
         }
         for (j = 0; j < sn->ns; j++) {
@@ -1220,6 +1366,7 @@ HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm
 /* d += e over the parts of the vector in use */
 HM_FUNC void ocp_qp_ipm_vec_add(const hm_ocp_qp_ipm_ws *ws, hm_ocp_qp_ipm_vec *d, const hm_ocp_qp_ipm_vec *e)
 {
+    const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     int n, i, k, j;
     for (n = 0; n <= HM_N; n++) {
         const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
@@ -1227,7 +1374,7 @@ HM_FUNC void ocp_qp_ipm_vec_add(const hm_ocp_qp_ipm_ws *ws, hm_ocp_qp_ipm_vec *d
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) d->y[n][i] += e->y[n][i];
         }
-        for (k = 0; k < sn->nbp; k++) {
+        for (k = 0; k < bd->nbp; k++) {
             d->zb[n][k][0] += e->zb[n][k][0];
             d->zb[n][k][1] += e->zb[n][k][1];
         }
@@ -1288,14 +1435,16 @@ HM_FUNC int ocp_qp_ipm_undecided_pair(hm_real t, hm_real z, hm_real dt, hm_real 
 
 HM_FUNC int ocp_qp_ipm_undecided(const hm_ocp_qp_ipm_ws *ws, hm_real alpha)
 {
+    const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     int n, k, l, j;
     if (!(alpha > HM_R(0.0))) return 0;
     for (n = 0; n <= HM_N; n++) {
         const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
-        for (k = 0; k < sn->nbp; k++) {
+        for (k = 0; k < bd->nbp; k++) {
             for (l = 0; l < 2; l++) {
-                if (sn->bsg[k][l] != HM_R(0.0)
-                    && ocp_qp_ipm_undecided_pair(sn->bt[k][l], sn->bz[k][l], sn->bdt[k][l], sn->bdz[k][l], alpha))
+                if (bd->sg[k][l][n] != HM_R(0.0)
+                    && ocp_qp_ipm_undecided_pair(bd->t[k][l][n], bd->z[k][l][n], bd->dt[k][l][n], bd->dz[k][l][n],
+                                                 alpha))
                     return 1;
             }
         }
@@ -1324,6 +1473,7 @@ HM_FUNC int ocp_qp_ipm_undecided(const hm_ocp_qp_ipm_ws *ws, hm_real alpha)
  * only if its worst KKT residual is smaller. */
 HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws, hm_real alpha)
 {
+    hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     hm_ocp_qp_ipm_vec *d = &ws->u.f.va;
     hm_ocp_qp_ipm_vec *e = &ws->u.f.vb;
     const hm_real wmax = ws->w_max;
@@ -1336,12 +1486,13 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
 
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
-        for (k = 0; k < sn->nbp; k++) {
+        for (k = 0; k < bd->nbp; k++) {
             for (l = 0; l < 2; l++) {
                 /* an absent side: dropped (its sign 0 keeps it out of the system anyway) */
-                const int act = sn->bsg[k][l] != HM_R(0.0)
-                                && ocp_qp_ipm_polish_active(sn->bt[k][l], sn->bz[k][l], sn->bdt[k][l], sn->bdz[k][l], alpha);
-                sn->bw[k][l] = act ? wmax : w_drop;
+                const int act = bd->sg[k][l][n] != HM_R(0.0)
+                                && ocp_qp_ipm_polish_active(bd->t[k][l][n], bd->z[k][l][n], bd->dt[k][l][n],
+                                                            bd->dz[k][l][n], alpha);
+                bd->w[k][l][n] = act ? wmax : w_drop;
             }
         }
         for (j = 0; j < sn->ns; j++) {
@@ -1366,9 +1517,9 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
             if (n < HM_N) {
                 for (i = 0; i < HM_NX; i++) e->y[n][i] = sn->beq[i];
             }
-            for (k = 0; k < sn->nbp; k++) {
-                e->zb[n][k][0] = sn->bb[k][0];
-                e->zb[n][k][1] = sn->bb[k][1];
+            for (k = 0; k < bd->nbp; k++) {
+                e->zb[n][k][0] = bd->b[k][0][n];
+                e->zb[n][k][1] = bd->b[k][1][n];
             }
             for (j = 0; j < sn->ns; j++) {
                 e->s[n][j] = -sn->szl[j];
@@ -1387,10 +1538,11 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
         for (n = 0; n <= HM_N; n++) {
             hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
             const hm_real *v = d->ux[n];
-            for (k = 0; k < sn->nbp; k++) {
+            for (k = 0; k < bd->nbp; k++) {
                 for (l = 0; l < 2; l++) {
-                    const hm_real slack = sn->bb[k][l] - sn->bsg[k][l] * v[sn->bc[k]];
-                    sn->bw[k][l] = ocp_qp_ipm_polish_weight(sn->bw[k][l], &d->zb[n][k][l], slack, wmax, w_drop, &changed);
+                    const hm_real slack = bd->b[k][l][n] - bd->sg[k][l][n] * v[bd->bc[k]];
+                    bd->w[k][l][n] = ocp_qp_ipm_polish_weight(bd->w[k][l][n], &d->zb[n][k][l], slack, wmax, w_drop,
+                                                              &changed);
                 }
             }
             for (j = 0; j < sn->ns; j++) {

@@ -366,14 +366,16 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp
 
 HM_FUNC void ocp_qp_kkt_condense_weights(hm_ocp_qp_ipm_ws *ws)
 {
+    const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     int n, k, j;
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
         hm_real h00 = HM_R(0.0), h10 = HM_R(0.0), h11 = HM_R(0.0);
         for (k = 0; k < HM_QP_NUX; k++) sn->Hd[k] = HM_R(0.0);
-        for (k = 0; k < sn->nbp; k++) {
-            const int c = sn->bc[k];
-            sn->Hd[c] += sn->bsg[k][0] * sn->bsg[k][0] * sn->bw[k][0] + sn->bsg[k][1] * sn->bsg[k][1] * sn->bw[k][1];
+        for (k = 0; k < bd->nbp; k++) {
+            const int c = bd->bc[k];
+            sn->Hd[c] += bd->sg[k][0][n] * bd->sg[k][0][n] * bd->w[k][0][n]
+                         + bd->sg[k][1][n] * bd->sg[k][1][n] * bd->w[k][1][n];
         }
         for (j = 0; j < sn->ns; j++) {
             /* a soft row with weight wr, slack-bound weight ws and slack Hessian Zl acts like a hard
@@ -411,14 +413,16 @@ HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws)
 
 /* Gradient of the condensed stage QP for a general right-hand side: h = -(rhs_v + A_I' W rhs_z)
  * with the soft slacks folded in (their step at a zero position step into e). */
-HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_vec *rhs, int n, hm_real *h)
+HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd, const hm_ocp_qp_ipm_vec *rhs,
+                                 int n, hm_real *h)
 {
     hm_real hp0 = HM_R(0.0), hp1 = HM_R(0.0);
     int i, k, j;
     for (i = 0; i < HM_QP_NUX; i++) h[i] = -rhs->ux[n][i];
-    for (k = 0; k < sn->nbp; k++) {
-        const int c = sn->bc[k];
-        h[c] -= sn->bsg[k][0] * sn->bw[k][0] * rhs->zb[n][k][0] + sn->bsg[k][1] * sn->bw[k][1] * rhs->zb[n][k][1];
+    for (k = 0; k < bd->nbp; k++) {
+        const int c = bd->bc[k];
+        h[c] -= bd->sg[k][0][n] * bd->w[k][0][n] * rhs->zb[n][k][0]
+                + bd->sg[k][1][n] * bd->w[k][1][n] * rhs->zb[n][k][1];
     }
     for (j = 0; j < sn->ns; j++) {
         hm_real coef = sn->swr[j] * rhs->zr[n][j];
@@ -439,15 +443,15 @@ HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_ve
 
 /* dz of the inequalities of stage n and the soft slack steps, from the (u, x) step of the stage.
  * Reads each entry of rhs before it writes the same entry of sol, so the two may be one vector. */
-HM_FUNC void ocp_qp_kkt_expand(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_vec *rhs,
-                               hm_ocp_qp_ipm_vec *sol, int n)
+HM_FUNC void ocp_qp_kkt_expand(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd,
+                               const hm_ocp_qp_ipm_vec *rhs, hm_ocp_qp_ipm_vec *sol, int n)
 {
     const hm_real *dux = sol->ux[n];
     const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
     int k, j, l;
-    for (k = 0; k < sn->nbp; k++) {
-        const int c = sn->bc[k];
-        for (l = 0; l < 2; l++) sol->zb[n][k][l] = sn->bw[k][l] * (sn->bsg[k][l] * dux[c] - rhs->zb[n][k][l]);
+    for (k = 0; k < bd->nbp; k++) {
+        const int c = bd->bc[k];
+        for (l = 0; l < 2; l++) sol->zb[n][k][l] = bd->w[k][l][n] * (bd->sg[k][l][n] * dux[c] - rhs->zb[n][k][l]);
     }
     for (j = 0; j < sn->ns; j++) {
         hm_real gd = -(sn->sd0[j] * dp0 + sn->sd1[j] * dp1);
@@ -470,7 +474,7 @@ HM_FUNC void ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const h
     for (n = HM_N; n >= 0; n--) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
         hm_real h[HM_QP_NUX];
-        ocp_qp_kkt_condense(sn, rhs, n, h);
+        ocp_qp_kkt_condense(sn, &ws->u.f.bd, rhs, n, h);
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) sn->ry[i] = rhs->y[n][i];
             ocp_qp_kkt_mv4(ws->u.f.st[n + 1].P, sn->ry, sn->Pry);
@@ -487,8 +491,8 @@ HM_FUNC void ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const h
             sol->ux[n + 1][HM_NU + i] = xn[i];
             sol->y[n][i] = dy[i];
         }
-        ocp_qp_kkt_expand(&ws->u.f.st[n], rhs, sol, n);
+        ocp_qp_kkt_expand(&ws->u.f.st[n], &ws->u.f.bd, rhs, sol, n);
     }
     for (i = 0; i < HM_NU; i++) sol->ux[HM_N][i] = HM_R(0.0);
-    ocp_qp_kkt_expand(&ws->u.f.st[HM_N], rhs, sol, HM_N);
+    ocp_qp_kkt_expand(&ws->u.f.st[HM_N], &ws->u.f.bd, rhs, sol, HM_N);
 }

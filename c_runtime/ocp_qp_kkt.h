@@ -29,6 +29,8 @@
 #include "hm_common.h"
 
 #define HM_QP_NUX (HM_NU + HM_NX)
+/* stages rounded up to a multiple of 8: the bound pairs are processed eight stages at a time */
+#define HM_QP_NNP ((HM_N + 8) / 8 * 8)
 /* rows per stage rounded up to even: rows are processed in pairs */
 #define HM_QP_NGP ((HM_NG + 1) / 2 * 2)
 

@@ -191,8 +191,9 @@ int qp_harness_kkt_map(int *m, int *off, int *nb, int *nr, int *ns, double *cost
     if (status) return status;
     for (n = 0; n <= HM_N; n++) {
         const hm_ocp_qp_ipm_stage *sn = &g_ws.u.f.st[n];
+        const hm_ocp_qp_ipm_bounds *bd = &g_ws.u.f.bd;
         int cnt = 0;
-        for (k = 0; k < sn->nbp; k++) cnt += (sn->bsg[k][0] != 0) + (sn->bsg[k][1] != 0);
+        for (k = 0; k < bd->nbp; k++) cnt += (bd->sg[k][0][n] != 0) + (bd->sg[k][1][n] != 0);
         off[n] = total;
         nb[n] = cnt;
         nr[n] = sn->ns + sn->nh;
@@ -215,6 +216,7 @@ int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
     int bad = 0, n, i, k, l, j, status, pos = 0;
     int kind[HM_NG], fam[HM_NG];
     hm_ocp_qp_ipm_vec *v = &g_vec;
+    hm_ocp_qp_ipm_bounds *bd = &g_ws.u.f.bd;
     if (ocp_qp_ipm_setup(&g_qp, &g_ws, &bad)) return HM_QP_INFEASIBLE;
     memset(v, 0, sizeof *v);
     for (n = 0; n <= HM_N; n++) {
@@ -223,11 +225,11 @@ int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) v->y[n][i] = rhs[off_y + n * HM_NX + i];
         }
-        for (k = 0; k < sn->nbp; k++) {
+        for (k = 0; k < bd->nbp; k++) {
             for (l = 0; l < 2; l++) {
-                sn->bw[k][l] = HM_R(1.0);
-                if (sn->bsg[k][l] == 0) continue;
-                sn->bw[k][l] = w[pos];
+                bd->w[k][l][n] = HM_R(1.0);
+                if (bd->sg[k][l][n] == 0) continue;
+                bd->w[k][l][n] = w[pos];
                 v->zb[n][k][l] = rhs[off_z + pos];
                 pos++;
             }
@@ -262,9 +264,9 @@ int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) sol[off_y + n * HM_NX + i] = v->y[n][i];
         }
-        for (k = 0; k < sn->nbp; k++) {
+        for (k = 0; k < bd->nbp; k++) {
             for (l = 0; l < 2; l++) {
-                if (sn->bsg[k][l] == 0) continue;
+                if (bd->sg[k][l][n] == 0) continue;
                 sol[off_z + pos++] = v->zb[n][k][l];
             }
         }
