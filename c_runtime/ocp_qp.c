@@ -138,8 +138,12 @@ HM_FUNC void ocp_qp_res_bound(hm_real v, hm_real lb, hm_real ub, hm_real lam_lb,
     res->dual = ocp_qp_max(res->dual, ocp_qp_max(-lam_lb, -lam_ub));
 }
 
-HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, hm_ocp_qp_res *res)
+HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, hm_ocp_qp_res *out)
 {
+    /* accumulated in a local copy: through the caller's pointer every max would be a store and a
+     * reload */
+    hm_ocp_qp_res local;
+    hm_ocp_qp_res *res = &local;
     int n, i, j, k, ng_n;
     hm_real obj = HM_R(0.0);
     res->stat = HM_R(0.0);
@@ -217,6 +221,7 @@ HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, h
         for (i = 0; i < HM_NX; i++) res->stat = ocp_qp_max(res->stat, hm_fabs(gx[i]));
     }
     res->obj = obj;
+    *out = local;
 }
 
 HM_FUNC hm_real ocp_qp_res_worst(const hm_ocp_qp_res *res)
