@@ -27,6 +27,9 @@
 #include "ocp_qp_ipm.h"
 #include "ocp_qp_hsde.c"
 
+/* hm_types.h writes the padded stage count of ocp_qp_ipm_bounds out; it must be HM_QP_NNP */
+typedef char ocp_qp_ipm_nnp_matches[sizeof(((hm_ocp_qp_ipm_bounds *)0)->v[0]) == HM_QP_NNP * sizeof(hm_real) ? 1 : -1];
+
 /* Cap of the weights z / t, relative to the curvature of the cost. Near the solution the weights
  * of active rows grow like 1 / mu; condensed into the Riccati recursion, whose Schur complements
  * subtract them again, they leave rounding errors of eps * weight in the moderate directions, and
@@ -126,8 +129,6 @@ HM_FUNC const char *ocp_qp_status_message(int status)
  * Setup: the families, the scaled cost, the norms, the starting point
  * ---------------------------------------------------------------------------------------------- */
 
-/* Builds the stage blocks of qp and the starting point. Returns HM_QP_INFEASIBLE if a lower bound
- * exceeds its upper bound; *bad = stage * HM_QP_NUX + component. */
 /* The bounds of component i of (u, x) at stage n (n <= HM_N); 0 if the stage has no such component
  * (u at stage HM_N, x at stage 0: not part of the problem). */
 HM_FUNC int ocp_qp_ipm_bounds_of(const hm_ocp_qp *qp, int n, int i, hm_real *lb, hm_real *ub)
@@ -144,6 +145,8 @@ HM_FUNC int ocp_qp_ipm_bounds_of(const hm_ocp_qp *qp, int n, int i, hm_real *lb,
     return 1;
 }
 
+/* Builds the stage blocks of qp and the starting point. Returns HM_QP_INFEASIBLE if a lower bound
+ * exceeds its upper bound; *bad = stage * HM_QP_NUX + component. */
 HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad)
 {
     hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
@@ -190,13 +193,14 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
             if (up) norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(ub));
             m += lp + up;
             for (l = 0; l < 2; l++) {
-                const hm_real t = bd->sg[k][l][n] != HM_R(0.0) ? OCP_QP_IPM_MAX(bd->b[k][l][n], HM_R(1.0)) : HM_R(1.0);
+                const int present = bd->sg[k][l][n] != HM_R(0.0);
+                const hm_real t = present ? OCP_QP_IPM_MAX(bd->b[k][l][n], HM_R(1.0)) : HM_R(1.0);
                 bd->t[k][l][n] = t;
-                bd->z[k][l][n] = bd->sg[k][l][n] != HM_R(0.0) ? HM_R(1.0) / t : HM_R(1.0);
+                bd->z[k][l][n] = present ? HM_R(1.0) / t : HM_R(1.0);
                 bd->dt[k][l][n] = HM_R(0.0);
                 bd->dz[k][l][n] = HM_R(0.0);
             }
-            bd->v[k][n] = bd->dv[k][n] = bd->dva[k][n] = HM_R(0.0);
+            bd->v[k][n] = bd->dv[k][n] = HM_R(0.0);
         }
     }
 
@@ -887,7 +891,7 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         hm_real hdl[HM_QP_NUX];
         ocp_qp_ipm_stage_step(qp, ws, n, dux, xn, dy);
         for (i = 0; i < HM_QP_NUX; i++) hdl[i] = HM_R(0.0);
-        for (k = 0; k < bd->nbp; k++) bd->dva[k][n] = dux[bd->bc[k]];
+        for (k = 0; k < bd->nbp; k++) bd->dv[k][n] = dux[bd->bc[k]];   /* pass A has taken E's */
         if (n > 0) {
             const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
             const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
@@ -962,7 +966,7 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         hm_real r_v[HM_QP_NNP], tdz_v[HM_QP_NNP], dtdz_v[HM_QP_NNP];
         for (n = 0; n < HM_QP_NNP; n++) r_v[n] = tdz_v[n] = dtdz_v[n] = HM_R(0.0);
         for (k = 0; k < bd->nbp; k++) {
-            const hm_real *restrict dvp = bd->dva[k];
+            const hm_real *restrict dvp = bd->dv[k];
             hm_real *restrict hdl_b = bd->hdl[k];
             for (n = 0; n < HM_QP_NNP; n++) hdl_b[n] = HM_R(0.0);
             for (l = 0; l < 2; l++)
@@ -1103,10 +1107,11 @@ HM_FUNC void ocp_qp_ipm_write_stage(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_
     }
     for (k = 0; k < bd->nbp; k++) {
         const int c = bd->bc[k];
-        /* an absent side has sign 0: its multiplier is written as 0 */
-        const hm_real lo = sc * bd->sg[k][0][n] * bd->sg[k][0][n] * zb[k][0];
-        const hm_real up = sc * bd->sg[k][1][n] * bd->sg[k][1][n] * zb[k][1];
+        hm_real lo, up;
         if (c < HM_NU ? n == HM_N : n == 0) continue;   /* the slot's component is not part of stage n */
+        /* an absent side has sign 0: its multiplier is written as 0 */
+        lo = sc * bd->sg[k][0][n] * bd->sg[k][0][n] * zb[k][0];
+        up = sc * bd->sg[k][1][n] * bd->sg[k][1][n] * zb[k][1];
         if (c < HM_NU) {
             sol->lam_lbu[n][c] = lo;
             sol->lam_ubu[n][c] = up;
