@@ -559,19 +559,13 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             const hm_real *restrict up = sp->ux;
             hm_real e[HM_NX];
             for (i = 0; i < HM_NX; i++) e[i] = ux[HM_NU + i] - B[i] * up[0] - B[i + HM_NX] * up[1];
+            /* all of A, also where its first columns are e_0, e_1 (sp->a_id): the products with
+             * 1 and 0 are exact, and a uniform loop keeps e in registers (the special case
+             * stored half of e and reloaded it whole, a failed store forwarding per stage) */
             if (n > 1) {
-                if (sp->a_id) {
-                    e[0] -= up[HM_NU];
-                    e[1] -= up[HM_NU + 1];
-                    for (k = 2; k < HM_NX; k++) {
-                        const hm_real xk = up[HM_NU + k];
-                        for (i = 0; i < HM_NX; i++) e[i] -= A[i + k * HM_NX] * xk;
-                    }
-                } else {
-                    for (k = 0; k < HM_NX; k++) {
-                        const hm_real xk = up[HM_NU + k];
-                        for (i = 0; i < HM_NX; i++) e[i] -= A[i + k * HM_NX] * xk;
-                    }
+                for (k = 0; k < HM_NX; k++) {
+                    const hm_real xk = up[HM_NU + k];
+                    for (i = 0; i < HM_NX; i++) e[i] -= A[i + k * HM_NX] * xk;
                 }
             }
             for (i = 0; i < HM_NX; i++) {
@@ -598,13 +592,9 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             if (n < HM_N) {
                 const hm_real *restrict A = qp->A[n];
                 const hm_real *restrict y = sn->y;
-                for (i = sn->a_id ? 2 : 0; i < HM_NX; i++) {
+                for (i = 0; i < HM_NX; i++) {
                     const hm_real *restrict a = &A[i * HM_NX];
                     atw[HM_NU + i] -= (a[0] * y[0] + a[1] * y[1]) + (a[2] * y[2] + a[3] * y[3]);
-                }
-                if (sn->a_id) {
-                    atw[HM_NU] -= y[0];
-                    atw[HM_NU + 1] -= y[1];
                 }
             }
         } else {
@@ -888,9 +878,10 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
     for (i = 0; i < HM_QP_NUX; i++) dux[i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
-        hm_real hdl[HM_QP_NUX];
+        /* the rows' part of hdl, on (px, py) only; kept in scalars and stored entry by entry: a
+         * local array half written and then copied whole is a failed store forwarding per stage */
+        hm_real hdl0 = HM_R(0.0), hdl1 = HM_R(0.0);
         ocp_qp_ipm_stage_step(qp, ws, n, dux, xn, dy);
-        for (i = 0; i < HM_QP_NUX; i++) hdl[i] = HM_R(0.0);
         for (k = 0; k < bd->nbp; k++) bd->dv[k][n] = dux[bd->bc[k]];   /* pass A has taken E's */
         if (n > 0) {
             const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
@@ -952,13 +943,15 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                     sb[l] += msk * del;
                 }
             }
-            hdl[HM_NU] += g0[0] + g0[1];
-            hdl[HM_NU + 1] += g1[0] + g1[1];
+            hdl0 = g0[0] + g0[1];
+            hdl1 = g1[0] + g1[1];
             ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(ra[0], ra[1]));
             tdz += sa[0] + sa[1];
             dtdz += sb[0] + sb[1];
         }
-        for (i = 0; i < HM_QP_NUX; i++) sn->hdl[i] = hdl[i];
+        for (i = 0; i < HM_QP_NUX; i++) sn->hdl[i] = HM_R(0.0);
+        sn->hdl[HM_NU] = hdl0;
+        sn->hdl[HM_NU + 1] = hdl1;
         for (i = 0; i < HM_NX; i++) dux[HM_NU + i] = xn[i];
     }
     /* bound pairs, all stages of a slot at once */
