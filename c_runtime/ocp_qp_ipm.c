@@ -849,20 +849,20 @@ typedef struct {
     hm_real dtdz;     /* sum dt dz */
 } ocp_qp_ipm_pred;
 
-/* The (u, x) step of stage n from the forward substitution: u (n < HM_N) and the carried state
- * step x (zero at n = 0); returns the next state step in xn and the dynamics' multiplier step. */
+/* The (u, x) step of stage n from the forward substitution, in place: reads the state step from
+ * sn->dux (zero at n = 0, written by stage n - 1 otherwise), writes the input step there and the
+ * next state step into stage n + 1's dux, and the dynamics' multiplier step into dy. The steps go
+ * straight to memory that the passes read entry by entry: copied through a local array, whose
+ * entries were stored one by one, they were reloaded whole (a failed store forwarding per stage). */
 HM_FUNC void ocp_qp_ipm_stage_step(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws, int n,
-                                   hm_real *restrict dux, hm_real *restrict xn, hm_real *restrict dy)
+                                   hm_real *restrict dy)
 {
-    int i;
+    hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
     if (n < HM_N) {
-        hm_real u[HM_NU];
-        ocp_qp_kkt_forward_stage(qp, &ws->u.f.st[n], &ws->u.f.st[n + 1], n, &dux[HM_NU], u, xn, dy);
-        dux[0] = u[0];
-        dux[1] = u[1];
+        hm_ocp_qp_ipm_stage *restrict sn1 = &ws->u.f.st[n + 1];
+        ocp_qp_kkt_forward_stage(qp, sn, sn1, n, &sn->dux[HM_NU], sn->dux, &sn1->dux[HM_NU], dy);
     } else {
-        dux[0] = dux[1] = HM_R(0.0);
-        for (i = 0; i < HM_NX; i++) xn[i] = HM_R(0.0);
+        sn->dux[0] = sn->dux[1] = HM_R(0.0);
     }
 }
 
@@ -871,88 +871,92 @@ HM_FUNC void ocp_qp_ipm_stage_step(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_w
 HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws,
                                ocp_qp_ipm_pred *restrict pr)
 {
-    hm_real dux[HM_QP_NUX], xn[HM_NX], dy[HM_NX];
+    hm_real dy[HM_NX];
     hm_real ratio = HM_R(0.0), tdz = HM_R(0.0), dtdz = HM_R(0.0);
     hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     int n, i, j, k, l;
-    for (i = 0; i < HM_QP_NUX; i++) dux[i] = HM_R(0.0);
+    /* the predictor's step lives in the stages' dux until pass E writes the corrector's over it
+     * (pass A has taken the last one) */
+    for (i = 0; i < HM_NX; i++) ws->u.f.st[0].dux[HM_NU + i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
-        hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
-        /* the rows' part of hdl, on (px, py) only; kept in scalars and stored entry by entry: a
-         * local array half written and then copied whole is a failed store forwarding per stage */
-        hm_real hdl0 = HM_R(0.0), hdl1 = HM_R(0.0);
-        ocp_qp_ipm_stage_step(qp, ws, n, dux, xn, dy);
-        for (k = 0; k < bd->nbp; k++) bd->dv[k][n] = dux[bd->bc[k]];   /* pass A has taken E's */
-        if (n > 0) {
-            const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
-            const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
-            hm_real g0[2] = {HM_R(0.0), HM_R(0.0)}, g1[2] = {HM_R(0.0), HM_R(0.0)};
-            hm_real ra[2] = {HM_R(0.0), HM_R(0.0)}, sa[2] = {HM_R(0.0), HM_R(0.0)}, sb[2] = {HM_R(0.0), HM_R(0.0)};
-            for (j = 0; j < sn->ns2; j += 2) {
-                for (l = 0; l < 2; l++) {
-                    const int q = j + l;
-                    const hm_real msk = sn->slive[q];
-                    const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q];
-                    const hm_real s = sn->ss[q], t = sn->st[q], z = sn->sz[q], zs = sn->szs[q];
-                    const hm_real wr = sn->swr[q], wsl = sn->sws[q], hinv = sn->shi[q];
-                    const hm_real zi = sn->szi[q], zsi = sn->szsi[q];
-                    const hm_real hw = hinv * wr, we = hw * (sn->sZl[q] + wsl);
-                    const hm_real gd = d0 * dp0 + d1 * dp1;
-                    const hm_real rho = sn->slg[q] - (d0 * p0 + d1 * p1) - s;
-                    const hm_real ds = hinv * (wr * rho - wsl * s - sn->srs[q]) - hw * gd;
-                    const hm_real dz = wr * (rho - gd - ds);
-                    const hm_real dzs = -wsl * (s + ds);
-#ifdef OCP_QP_IPM_DT_PRIMAL
-                    const hm_real dt = gd + ds - (t + rho);
-#else
-                    const hm_real dt = -t - t * dz * zi;
-#endif
-                    const hm_real dr = dt * dz, dsb = ds * dzs;
-                    const hm_real coef = we * zi * dr - hw * wsl * zsi * dsb;
-                    sn->sdr[q] = dr;
-                    sn->sdsb[q] = dsb;
-                    g0[l] += d0 * coef;
-                    g1[l] += d1 * coef;
-                    ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sn->sti[q], -dz * zi),
-                                                                  OCP_QP_IPM_MAX(-ds * sn->ssi[q], -dzs * zsi)));
-                    sa[l] += msk * (t * dz + z * dt + s * dzs + zs * ds);
-                    sb[l] += msk * (dr + dsb);
+        ocp_qp_ipm_stage_step(qp, ws, n, dy);
+        {
+            hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+            const hm_real *restrict dux = sn->dux;
+            /* the rows' part of hdl, on (px, py) only; kept in scalars and stored entry by entry: a
+             * local array half written and then copied whole is a failed store forwarding per stage */
+            hm_real hdl0 = HM_R(0.0), hdl1 = HM_R(0.0);
+            for (k = 0; k < bd->nbp; k++) bd->dv[k][n] = dux[bd->bc[k]];   /* pass A has taken E's */
+            if (n > 0) {
+                const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
+                const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
+                hm_real g0[2] = {HM_R(0.0), HM_R(0.0)}, g1[2] = {HM_R(0.0), HM_R(0.0)};
+                hm_real ra[2] = {HM_R(0.0), HM_R(0.0)}, sa[2] = {HM_R(0.0), HM_R(0.0)}, sb[2] = {HM_R(0.0), HM_R(0.0)};
+                for (j = 0; j < sn->ns2; j += 2) {
+                    for (l = 0; l < 2; l++) {
+                        const int q = j + l;
+                        const hm_real msk = sn->slive[q];
+                        const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q];
+                        const hm_real s = sn->ss[q], t = sn->st[q], z = sn->sz[q], zs = sn->szs[q];
+                        const hm_real wr = sn->swr[q], wsl = sn->sws[q], hinv = sn->shi[q];
+                        const hm_real zi = sn->szi[q], zsi = sn->szsi[q];
+                        const hm_real hw = hinv * wr, we = hw * (sn->sZl[q] + wsl);
+                        const hm_real gd = d0 * dp0 + d1 * dp1;
+                        const hm_real rho = sn->slg[q] - (d0 * p0 + d1 * p1) - s;
+                        const hm_real ds = hinv * (wr * rho - wsl * s - sn->srs[q]) - hw * gd;
+                        const hm_real dz = wr * (rho - gd - ds);
+                        const hm_real dzs = -wsl * (s + ds);
+    #ifdef OCP_QP_IPM_DT_PRIMAL
+                        const hm_real dt = gd + ds - (t + rho);
+    #else
+                        const hm_real dt = -t - t * dz * zi;
+    #endif
+                        const hm_real dr = dt * dz, dsb = ds * dzs;
+                        const hm_real coef = we * zi * dr - hw * wsl * zsi * dsb;
+                        sn->sdr[q] = dr;
+                        sn->sdsb[q] = dsb;
+                        g0[l] += d0 * coef;
+                        g1[l] += d1 * coef;
+                        ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sn->sti[q], -dz * zi),
+                                                                      OCP_QP_IPM_MAX(-ds * sn->ssi[q], -dzs * zsi)));
+                        sa[l] += msk * (t * dz + z * dt + s * dzs + zs * ds);
+                        sb[l] += msk * (dr + dsb);
+                    }
                 }
-            }
-            for (j = 0; j < sn->nh2; j += 2) {
-                for (l = 0; l < 2; l++) {
-                    const int q = j + l;
-                    const hm_real msk = sn->hlive[q];
-                    const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q];
-                    const hm_real t = sn->ht[q], z = sn->hz[q], w = sn->hw[q], zi = sn->hzi[q];
-                    const hm_real gd = d0 * dp0 + d1 * dp1;
-                    const hm_real rho = sn->hlg[q] - (d0 * p0 + d1 * p1);
-                    const hm_real dz = w * (rho - gd);
-#ifdef OCP_QP_IPM_DT_PRIMAL
-                    const hm_real dt = gd - (t + rho);
-#else
-                    const hm_real dt = -t - t * dz * zi;
-#endif
-                    const hm_real del = dt * dz;
-                    const hm_real coef = w * zi * del;
-                    sn->hdel[q] = del;
-                    g0[l] += d0 * coef;
-                    g1[l] += d1 * coef;
-                    ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hti[q], -dz * zi));
-                    sa[l] += msk * (t * dz + z * dt);
-                    sb[l] += msk * del;
+                for (j = 0; j < sn->nh2; j += 2) {
+                    for (l = 0; l < 2; l++) {
+                        const int q = j + l;
+                        const hm_real msk = sn->hlive[q];
+                        const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q];
+                        const hm_real t = sn->ht[q], z = sn->hz[q], w = sn->hw[q], zi = sn->hzi[q];
+                        const hm_real gd = d0 * dp0 + d1 * dp1;
+                        const hm_real rho = sn->hlg[q] - (d0 * p0 + d1 * p1);
+                        const hm_real dz = w * (rho - gd);
+    #ifdef OCP_QP_IPM_DT_PRIMAL
+                        const hm_real dt = gd - (t + rho);
+    #else
+                        const hm_real dt = -t - t * dz * zi;
+    #endif
+                        const hm_real del = dt * dz;
+                        const hm_real coef = w * zi * del;
+                        sn->hdel[q] = del;
+                        g0[l] += d0 * coef;
+                        g1[l] += d1 * coef;
+                        ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hti[q], -dz * zi));
+                        sa[l] += msk * (t * dz + z * dt);
+                        sb[l] += msk * del;
+                    }
                 }
+                hdl0 = g0[0] + g0[1];
+                hdl1 = g1[0] + g1[1];
+                ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(ra[0], ra[1]));
+                tdz += sa[0] + sa[1];
+                dtdz += sb[0] + sb[1];
             }
-            hdl0 = g0[0] + g0[1];
-            hdl1 = g1[0] + g1[1];
-            ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(ra[0], ra[1]));
-            tdz += sa[0] + sa[1];
-            dtdz += sb[0] + sb[1];
+            for (i = 0; i < HM_QP_NUX; i++) sn->hdl[i] = HM_R(0.0);
+            sn->hdl[HM_NU] = hdl0;
+            sn->hdl[HM_NU + 1] = hdl1;
         }
-        for (i = 0; i < HM_QP_NUX; i++) sn->hdl[i] = HM_R(0.0);
-        sn->hdl[HM_NU] = hdl0;
-        sn->hdl[HM_NU + 1] = hdl1;
-        for (i = 0; i < HM_NX; i++) dux[HM_NU + i] = xn[i];
     }
     /* bound pairs, all stages of a slot at once */
     {
@@ -987,73 +991,73 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
 HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws, hm_real smu,
                                   hm_real kdel)
 {
-    hm_real dux[HM_QP_NUX], xn[HM_NX];
     hm_real ratio = HM_R(0.0);
     hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     int n, i, j, k, l;
-    for (i = 0; i < HM_QP_NUX; i++) dux[i] = HM_R(0.0);
+    for (i = 0; i < HM_NX; i++) ws->u.f.st[0].dux[HM_NU + i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
-        hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
-        ocp_qp_ipm_stage_step(qp, ws, n, dux, xn, sn->dy);
-        for (i = 0; i < HM_QP_NUX; i++) sn->dux[i] = dux[i];
-        for (k = 0; k < bd->nbp; k++) bd->dv[k][n] = dux[bd->bc[k]];
-        if (n > 0) {
-            const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
-            const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
-            hm_real ra[2] = {HM_R(0.0), HM_R(0.0)};
-            for (j = 0; j < sn->ns2; j += 2) {
-                for (l = 0; l < 2; l++) {
-                    const int q = j + l;
-                    const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q];
-                    const hm_real s = sn->ss[q], t = sn->st[q], z = sn->sz[q];
-                    const hm_real wr = sn->swr[q], wsl = sn->sws[q], hinv = sn->shi[q];
-                    const hm_real zi = sn->szi[q], zsi = sn->szsi[q];
-                    const hm_real cr = smu - kdel * sn->sdr[q], cs = smu - kdel * sn->sdsb[q];
-                    const hm_real hw = hinv * wr;
-                    const hm_real gd = d0 * dp0 + d1 * dp1;
-                    const hm_real rho0 = sn->slg[q] - (d0 * p0 + d1 * p1) - s;
-                    const hm_real rho = rho0 + cr * zi;
-                    const hm_real rhos = cs * zsi - s;
-                    const hm_real ds = hinv * (wr * rho + wsl * rhos - sn->srs[q]) - hw * gd;
-                    const hm_real dz = wr * (rho - gd - ds);
-                    const hm_real dzs = wsl * (rhos - ds);
-#ifdef OCP_QP_IPM_DT_PRIMAL
-                    const hm_real dt = gd + ds - (t + rho0);
-                    (void)z;
-#else
-                    const hm_real dt = -(t * z - cr + t * dz) * zi;
-#endif
-                    sn->sds[q] = ds;
-                    sn->sdt[q] = dt;
-                    sn->sdz[q] = dz;
-                    sn->sdzs[q] = dzs;
-                    ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sn->sti[q], -dz * zi),
-                                                                  OCP_QP_IPM_MAX(-ds * sn->ssi[q], -dzs * zsi)));
+        ocp_qp_ipm_stage_step(qp, ws, n, ws->u.f.st[n].dy);
+        {
+            hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+            const hm_real *restrict dux = sn->dux;
+            for (k = 0; k < bd->nbp; k++) bd->dv[k][n] = dux[bd->bc[k]];
+            if (n > 0) {
+                const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
+                const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
+                hm_real ra[2] = {HM_R(0.0), HM_R(0.0)};
+                for (j = 0; j < sn->ns2; j += 2) {
+                    for (l = 0; l < 2; l++) {
+                        const int q = j + l;
+                        const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q];
+                        const hm_real s = sn->ss[q], t = sn->st[q], z = sn->sz[q];
+                        const hm_real wr = sn->swr[q], wsl = sn->sws[q], hinv = sn->shi[q];
+                        const hm_real zi = sn->szi[q], zsi = sn->szsi[q];
+                        const hm_real cr = smu - kdel * sn->sdr[q], cs = smu - kdel * sn->sdsb[q];
+                        const hm_real hw = hinv * wr;
+                        const hm_real gd = d0 * dp0 + d1 * dp1;
+                        const hm_real rho0 = sn->slg[q] - (d0 * p0 + d1 * p1) - s;
+                        const hm_real rho = rho0 + cr * zi;
+                        const hm_real rhos = cs * zsi - s;
+                        const hm_real ds = hinv * (wr * rho + wsl * rhos - sn->srs[q]) - hw * gd;
+                        const hm_real dz = wr * (rho - gd - ds);
+                        const hm_real dzs = wsl * (rhos - ds);
+    #ifdef OCP_QP_IPM_DT_PRIMAL
+                        const hm_real dt = gd + ds - (t + rho0);
+                        (void)z;
+    #else
+                        const hm_real dt = -(t * z - cr + t * dz) * zi;
+    #endif
+                        sn->sds[q] = ds;
+                        sn->sdt[q] = dt;
+                        sn->sdz[q] = dz;
+                        sn->sdzs[q] = dzs;
+                        ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sn->sti[q], -dz * zi),
+                                                                      OCP_QP_IPM_MAX(-ds * sn->ssi[q], -dzs * zsi)));
+                    }
                 }
-            }
-            for (j = 0; j < sn->nh2; j += 2) {
-                for (l = 0; l < 2; l++) {
-                    const int q = j + l;
-                    const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q];
-                    const hm_real t = sn->ht[q], z = sn->hz[q], w = sn->hw[q], zi = sn->hzi[q];
-                    const hm_real cc = smu - kdel * sn->hdel[q];
-                    const hm_real gd = d0 * dp0 + d1 * dp1;
-                    const hm_real rho0 = sn->hlg[q] - (d0 * p0 + d1 * p1);
-                    const hm_real dz = w * (rho0 + cc * zi - gd);
-#ifdef OCP_QP_IPM_DT_PRIMAL
-                    const hm_real dt = gd - (t + rho0);
-                    (void)z;
-#else
-                    const hm_real dt = -(t * z - cc + t * dz) * zi;
-#endif
-                    sn->hdz[q] = dz;
-                    sn->hdt[q] = dt;
-                    ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hti[q], -dz * zi));
+                for (j = 0; j < sn->nh2; j += 2) {
+                    for (l = 0; l < 2; l++) {
+                        const int q = j + l;
+                        const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q];
+                        const hm_real t = sn->ht[q], z = sn->hz[q], w = sn->hw[q], zi = sn->hzi[q];
+                        const hm_real cc = smu - kdel * sn->hdel[q];
+                        const hm_real gd = d0 * dp0 + d1 * dp1;
+                        const hm_real rho0 = sn->hlg[q] - (d0 * p0 + d1 * p1);
+                        const hm_real dz = w * (rho0 + cc * zi - gd);
+    #ifdef OCP_QP_IPM_DT_PRIMAL
+                        const hm_real dt = gd - (t + rho0);
+                        (void)z;
+    #else
+                        const hm_real dt = -(t * z - cc + t * dz) * zi;
+    #endif
+                        sn->hdz[q] = dz;
+                        sn->hdt[q] = dt;
+                        ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hti[q], -dz * zi));
+                    }
                 }
+                ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(ra[0], ra[1]));
             }
-            ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(ra[0], ra[1]));
         }
-        for (i = 0; i < HM_NX; i++) dux[HM_NU + i] = xn[i];
     }
     /* bound pairs, all stages of a slot at once */
     {
