@@ -49,6 +49,7 @@ HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
     int n, i;
     s->warm = 0;
     s->prepared = 0;
+    s->dyn_fresh = 0;
     for (n = 0; n < HM_N; n++)
         for (i = 0; i < HM_NU; i++) s->u[n][i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++)
@@ -58,12 +59,13 @@ HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
     s->screen_radius[0] = HM_INF;
 }
 
-/* x_{n+1} = F(x_n, u_n) for n = 0..N-1 from the given x_0. */
+/* x_{n+1} = F(x_n, u_n) for n = 0..N-1 from the given x_0. The Jacobians come with the model's
+ * values; they are kept in the QP for the linearisation that follows (s->dyn_fresh). */
 static void ocp_nlp_simulate(hm_solver *s)
 {
     int n;
-    hm_real A[HM_NX * HM_NX], B[HM_NX * HM_NU];
-    for (n = 0; n < HM_N; n++) hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], A, B);
+    for (n = 0; n < HM_N; n++) hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], s->qp.A[n], s->qp.B[n]);
+    s->dyn_fresh = 1;
 }
 
 /* a[r][.] <- a[r + 1][.] for r < rows - 1; the last row is kept. */
@@ -116,14 +118,14 @@ static void ocp_nlp_shift(hm_solver *s, const hm_input *in)
 static void ocp_nlp_init_braking(hm_solver *s, const hm_input *in)
 {
     const hm_real a_min = s->params.a_bounds[0], a_max = s->params.a_bounds[1];
-    hm_real A[HM_NX * HM_NX], B[HM_NX * HM_NU];
     int n, i;
     for (i = 0; i < HM_NX; i++) s->x[0][i] = in->x0[i];
     for (n = 0; n < HM_N; n++) {
         s->u[n][0] = hm_fmin(hm_fmax(-s->x[n][3] / HM_R(HM_DT), a_min), a_max);
         s->u[n][1] = HM_R(0.0);
-        hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], A, B);
+        hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], s->qp.A[n], s->qp.B[n]);
     }
+    s->dyn_fresh = 1;
     ocp_qp_sol_set_zero(&s->mult);
     ocp_nlp_screen_reach(s);
 }
@@ -240,9 +242,15 @@ static void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
         hm_real l;
 
         if (n < HM_N) {
-            hm_real x_next[HM_NX];
-            hm_model_dynamics(x, s->u[n], x_next, qp->A[n], qp->B[n]);
-            for (i = 0; i < HM_NX; i++) qp->b[n][i] = x_next[i] - s->x[n + 1][i];
+            if (s->dyn_fresh) {
+                /* simulated from this very iterate: the same evaluation would give x_next =
+                 * x[n + 1] exactly, and the Jacobians are in qp already */
+                for (i = 0; i < HM_NX; i++) qp->b[n][i] = HM_R(0.0);
+            } else {
+                hm_real x_next[HM_NX];
+                hm_model_dynamics(x, s->u[n], x_next, qp->A[n], qp->B[n]);
+                for (i = 0; i < HM_NX; i++) qp->b[n][i] = x_next[i] - s->x[n + 1][i];
+            }
             hm_model_cost_stage(x, s->u[n], in->goal, p->w_goal, p->w_control, &l, q, qp->r[n], Q, qp->R[n]);
             for (i = 0; i < HM_NU; i++) qp->R[n][i + i * HM_NU] += reg;
             for (i = 0; i < HM_NU * HM_NX; i++) qp->S[n][i] = HM_R(0.0);
@@ -314,6 +322,7 @@ static void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
             penalty += ocp_nlp_slack_penalty(g, l1, l2);
         }
     }
+    s->dyn_fresh = 0;
     if (exact)
         for (n = 0; n <= HM_N; n++) ocp_nlp_convexify_stage(qp, n, hm_fmax(reg, HM_R(1e-8)));
     s->cost = cost + penalty;
@@ -504,6 +513,7 @@ static void ocp_nlp_step_from_base(hm_solver *s, hm_real alpha)
 {
     int n, i;
     const hm_ocp_qp_sol *d = &s->qp_sol;
+    s->dyn_fresh = 0;
     for (n = 0; n <= HM_N; n++)
         for (i = 0; i < HM_NX; i++) s->x[n][i] = s->x_base[n][i] + alpha * d->x[n][i];
     for (n = 0; n < HM_N; n++)

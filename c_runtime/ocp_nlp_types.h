@@ -17,6 +17,8 @@ typedef struct HM_NS(solver) {
     int warm;        /* 1: x, u, mult hold a previous solution to shift */
     int prepared;    /* 1: qp holds the linearisation for the next feedback */
     int n_active;    /* humans and obstacle rows of the current linearisation */
+    int dyn_fresh;   /* 1: qp.A, qp.B are the dynamics' Jacobians at the iterate, which was just
+                        simulated (no gaps): the next linearisation need not evaluate them again */
     /* Row screening (ocp_nlp_sqp.c): rows of stage n whose linearised margin exceeds screen_radius[n]
      * are left out of the QP (ng_full[n] rows built, qp.ng[n] passed), in the order row_perm, and
      * checked after. */

@@ -103,8 +103,10 @@ def emit_model(functions: tuple[ModelFunction, ...], prefix: str, real: str, out
     for mf in functions:
         casadi_name = f"{prefix}_model_{mf.name}"
         fn = mf.function
-        # Rebuild under the prefixed name: CasADi names the C symbol after the Function.
-        renamed = ca.Function(casadi_name, fn.sx_in(), fn.call(fn.sx_in()), fn.name_in(), fn.name_out())
+        # Rebuild under the prefixed name: CasADi names the C symbol after the Function. Common
+        # subexpressions merged (ca.cse): derivatives rebuild nodes that the values already have.
+        ins = fn.sx_in()
+        renamed = ca.Function(casadi_name, ins, ca.cse(fn.call(ins)), fn.name_in(), fn.name_out())
         cg.add(renamed)
         emitted.append(
             EmittedFunction(

@@ -68,6 +68,32 @@ def collision_potential(d: ca.SX, q: ca.SX, d_th: ca.SX, kappa: ca.SX) -> ca.SX:
     return ca.if_else(d <= d_th, linear, logistic)
 
 
+def reciprocal(x: ca.SX) -> ca.SX:
+    """1 / x for x > 0, kept as one factor: CasADi rewrites a * (1 / x) into a / x at every use, so
+    an expression that multiplies by a reciprocal k times would divide k times. The no-op fmax with 0
+    is an operation CasADi does not see through."""
+    return ca.fmax(1.0 / x, 0.0)
+
+
+def collision_potential_derivatives(
+    d: ca.SX, q: ca.SX, d_th: ca.SX, kappa: ca.SX
+) -> tuple[ca.SX, ca.SX, ca.SX]:
+    """f(d), f'(d) and f''(d) of collision_potential, differentiated by hand.
+
+    With e as there and s = 1 / (1 + e), the logistic branch is f = q e s, f' = -kappa q e s^2 and
+    f'' = kappa^2 q e (1 - e) s^3: one division where CasADi's derivatives of q e / (1 + e) take
+    seven. Both branches meet at d_th with f' = -kappa q / 4 and f'' = 0 (tests compare all three
+    with finite differences and with the paper's formulas).
+    """
+    e = ca.exp(-kappa * (ca.fmax(d, d_th) - d_th))
+    s = reciprocal(1.0 + e)
+    below = d <= d_th
+    f = ca.if_else(below, -(kappa * q / 4.0) * d + (q / 2.0 + kappa * q * d_th / 4.0), q * e * s)
+    df = ca.if_else(below, -(kappa * q / 4.0), -kappa * q * e * s * s)
+    d2f = ca.if_else(below, 0.0, kappa * kappa * q * e * (1.0 - e) * s * s * s)
+    return f, df, d2f
+
+
 def unicycle_ode(x: ca.SX, u: ca.SX) -> ca.SX:
     return ca.vertcat(x[3] * ca.cos(x[2]), x[3] * ca.sin(x[2]), u[1], u[0])
 
@@ -162,15 +188,17 @@ class OcpModel:
 
         # Collision cost of one human: convex-over-nonlinear f(d(p, h)). The generalised
         # Gauss-Newton Hessian f''(d) grad d grad d' is PSD because f'' >= 0; the gradient is exact.
+        # It is evaluated for every human at every node of every step, so the derivatives are
+        # written out: grad d = (p - h) / d and hess d = (I - grad d grad d') / d share one
+        # reciprocal, and f', f'' one more (collision_potential_derivatives).
         d_sym = ca.SX.sym("d")
-        f_of_d = collision_potential(d_sym, q, d_th, kappa)
-        df = ca.jacobian(f_of_d, d_sym)
-        d2f = ca.jacobian(df, d_sym)
+        f_of_d, df, d2f = collision_potential_derivatives(d_sym, q, d_th, kappa)
         potential = ca.Function("f", [d_sym, q, d_th, kappa], [f_of_d, df, d2f])
         dist = smooth_distance(p, c)
-        grad_d = ca.gradient(dist, p)
-        f_val, f_d, f_dd = potential(dist, q, d_th, kappa)
-        hess_d = ca.hessian(dist, p)[0]
+        inv_dist = reciprocal(dist)
+        grad_d = (p - c) * inv_dist
+        f_val, f_d, f_dd = collision_potential_derivatives(dist, q, d_th, kappa)
+        hess_d = (ca.SX.eye(NP) - grad_d @ grad_d.T) * inv_dist
         functions.append(
             self._make(
                 "cost_collision",
@@ -193,7 +221,7 @@ class OcpModel:
                 "distance_constraint",
                 "distance row d(p, c) - d_min (>= 0 when satisfied), its Jacobian and Hessian w.r.t. p",
                 [("p", p), ("c", c), ("d_min", d_min)],
-                [("g", dist - d_min), ("jac_p", ca.jacobian(dist, p)), ("hess_p", hess_d)],
+                [("g", dist - d_min), ("jac_p", grad_d.T), ("hess_p", hess_d)],
             )
         )
 
