@@ -70,9 +70,9 @@ def collision_potential(d: ca.SX, q: ca.SX, d_th: ca.SX, kappa: ca.SX) -> ca.SX:
 
 def reciprocal(x: ca.SX) -> ca.SX:
     """1 / x for x > 0, kept as one factor: CasADi rewrites a * (1 / x) into a / x at every use, so
-    an expression that multiplies by a reciprocal k times would divide k times. The no-op fmax with 0
-    is an operation CasADi does not see through."""
-    return ca.fmax(1.0 / x, 0.0)
+    an expression that multiplies by a reciprocal k times would divide k times. The no-op fabs is an
+    operation CasADi does not see through (and C compiles it to a bit mask; fmax would be a libm call)."""
+    return ca.fabs(1.0 / x)
 
 
 def collision_potential_derivatives(
@@ -85,7 +85,8 @@ def collision_potential_derivatives(
     seven. Both branches meet at d_th with f' = -kappa q / 4 and f'' = 0 (tests compare all three
     with finite differences and with the paper's formulas).
     """
-    e = ca.exp(-kappa * (ca.fmax(d, d_th) - d_th))
+    # the excess over d_th as a select, not fmax: in C99 CasADi's fmax is a libm call
+    e = ca.exp(-kappa * ca.if_else(d > d_th, d - d_th, 0.0))
     s = reciprocal(1.0 + e)
     below = d <= d_th
     f = ca.if_else(below, -(kappa * q / 4.0) * d + (q / 2.0 + kappa * q * d_th / 4.0), q * e * s)
