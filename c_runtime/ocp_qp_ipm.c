@@ -512,6 +512,17 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
     for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = pv_v[i] = atw_v[i] = HM_R(0.0);
     for (i = 0; i < HM_NX; i++) eq_v[i] = rpe_v[i] = HM_R(0.0);
 
+    /* the step, for all stages before the stage loop reads them: updated inside it, a stage's
+     * (u, x) was stored in parts and read back across those parts while the stores were still in
+     * flight (a failed store forwarding per stage) */
+    for (n = 0; n <= HM_N; n++) {
+        hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+        for (i = 0; i < HM_QP_NUX; i++) sn->ux[i] += alpha * sn->dux[i];
+        if (n < HM_N) {
+            for (i = 0; i < HM_NX; i++) sn->y[i] += alpha * sn->dy[i];
+        }
+    }
+
     /* bound pairs, all stages of a slot at once (an absent side has sign 0 and stays at t = z = 1);
      * their parts of A' w, of the diagonal and of the gradients go to the stage loop below */
     {
@@ -544,12 +555,6 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
         hm_real *restrict ux = sn->ux;
         hm_real Pux[HM_QP_NUX], atw[HM_QP_NUX], hf[HM_QP_NUX], hmu[HM_QP_NUX], Hd[HM_QP_NUX];
-
-        /* the step */
-        for (i = 0; i < HM_QP_NUX; i++) ux[i] += alpha * sn->dux[i];
-        if (n < HM_N) {
-            for (i = 0; i < HM_NX; i++) sn->y[i] += alpha * sn->dy[i];
-        }
 
         /* dynamics n - 1 -> n: x_n - A x_{n-1} - B u_{n-1} = b_{n-1} */
         if (n > 0) {
