@@ -11,6 +11,7 @@ typedef HM_NS(ocp_qp_res) hm_ocp_qp_res;
 typedef HM_NS(ocp_qp_ipm_arg) hm_ocp_qp_ipm_arg;
 typedef HM_NS(ocp_qp_ipm_stage) hm_ocp_qp_ipm_stage;
 typedef HM_NS(ocp_qp_ipm_bounds) hm_ocp_qp_ipm_bounds;
+typedef HM_NS(ocp_qp_ipm_rows) hm_ocp_qp_ipm_rows;
 typedef HM_NS(ocp_qp_ipm_vec) hm_ocp_qp_ipm_vec;
 typedef HM_NS(ocp_qp_ipm_ws) hm_ocp_qp_ipm_ws;
 typedef HM_NS(ocp_qp_hsde_vec) hm_ocp_qp_hsde_vec;

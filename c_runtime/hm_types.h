@@ -132,29 +132,13 @@ typedef struct HM_NS(ocp_qp_outcome) {
 typedef struct HM_NS(ocp_qp_ipm_stage) {
     /* structure, set up by every solve */
     int ns, nh;                       /* soft rows, hard rows */
+    int soff;                         /* soft row j of the stage is row soff + j of ocp_qp_ipm_rows */
     int ns2, nh2;                     /* the same rounded up to even (rows go in pairs) */
     int a_id;                         /* 1: the first two columns of A_n are e_0, e_1 */
-    unsigned char srow[(HM_NG + 1) / 2 * 2];   /* QP row of soft row j */
     unsigned char hrow[(HM_NG + 1) / 2 * 2];   /* QP row of hard row j */
     /* cost times the cost scale (stage 0: x_0 terms folded into q), dynamics offset (stage 0:
      * b_0 + A_0 x_0); column-major like ocp_qp */
     HM_REAL R[HM_NU * HM_NU], S[HM_NU * HM_NX], Q[HM_NX * HM_NX], q[HM_NU + HM_NX], beq[HM_NX];
-
-    /* soft rows: -(d' p + s) + t = -lg, s >= 0; cost zl s + Zl s^2 / 2 (times the cost scale);
-     * live 1, or 0 for the padding row */
-    HM_REAL sd0[(HM_NG + 1) / 2 * 2], sd1[(HM_NG + 1) / 2 * 2], slg[(HM_NG + 1) / 2 * 2];
-    HM_REAL szl[(HM_NG + 1) / 2 * 2], sZl[(HM_NG + 1) / 2 * 2], slive[(HM_NG + 1) / 2 * 2];
-    HM_REAL ss[(HM_NG + 1) / 2 * 2], st[(HM_NG + 1) / 2 * 2];    /* slack s, row slack t */
-    HM_REAL sz[(HM_NG + 1) / 2 * 2], szs[(HM_NG + 1) / 2 * 2];   /* multipliers of the row, of s >= 0 */
-    HM_REAL sds[(HM_NG + 1) / 2 * 2], sdt[(HM_NG + 1) / 2 * 2];
-    HM_REAL sdz[(HM_NG + 1) / 2 * 2], sdzs[(HM_NG + 1) / 2 * 2];
-    HM_REAL swr[(HM_NG + 1) / 2 * 2], sws[(HM_NG + 1) / 2 * 2];  /* weights z/t, zs/s */
-    HM_REAL shi[(HM_NG + 1) / 2 * 2];                            /* 1 / (Zl + wr + ws) */
-    HM_REAL sti[(HM_NG + 1) / 2 * 2], szi[(HM_NG + 1) / 2 * 2];  /* 1/t, 1/z */
-    HM_REAL ssi[(HM_NG + 1) / 2 * 2], szsi[(HM_NG + 1) / 2 * 2]; /* 1/s, 1/zs */
-    HM_REAL srs[(HM_NG + 1) / 2 * 2];                            /* stationarity residual of s */
-    HM_REAL sdr[(HM_NG + 1) / 2 * 2], sdsb[(HM_NG + 1) / 2 * 2]; /* dt dz, ds dzs of the predictor */
-    HM_REAL se[(HM_NG + 1) / 2 * 2];   /* general solve: slack step at a zero position step */
 
     /* hard rows: -d' p + t = -lg */
     HM_REAL hd0[(HM_NG + 1) / 2 * 2], hd1[(HM_NG + 1) / 2 * 2], hlg[(HM_NG + 1) / 2 * 2];
@@ -207,6 +191,34 @@ typedef struct HM_NS(ocp_qp_ipm_bounds) {
     HM_REAL hmu[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
     HM_REAL hdl[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
 } HM_NS(ocp_qp_ipm_bounds);
+
+/* The soft rows of all stages in one list: stage after stage, each stage's ns rows padded to an even
+ * count (ns2, the padding row absent), the list padded to a multiple of 8 with absent rows (live 0,
+ * d = 0, at the neutral state s = t = z = zs = 1; HM_QP_NR of ocp_qp_kkt.h). Row r of stage n:
+ * -(d' p + s) + t = -lg, s >= 0, cost zl s + Zl s^2 / 2 (times the cost scale). The passes of the
+ * interior-point method run over the list eight rows at a time; p0, p1 (and dp0, dp1) copy the
+ * position (and its step) of each row's stage. */
+typedef struct HM_NS(ocp_qp_ipm_rows) {
+    int nr;                           /* rows in the list, padding rows of the stages included */
+    unsigned char srow[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];  /* QP row of the row within its stage */
+    HM_REAL sd0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sd1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], slg[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
+    HM_REAL szl[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sZl[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], slive[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
+    HM_REAL ss[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], st[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];            /* slack s, row slack t */
+    HM_REAL sz[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], szs[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];           /* multipliers of the row, of s >= 0 */
+    HM_REAL sds[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sdt[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
+    HM_REAL sdz[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sdzs[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
+    HM_REAL swr[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sws[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];          /* weights z/t, zs/s */
+    HM_REAL shi[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];                  /* 1 / (Zl + wr + ws) */
+    HM_REAL sti[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], szi[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];          /* 1/t, 1/z */
+    HM_REAL ssi[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], szsi[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];         /* 1/s, 1/zs */
+    HM_REAL srs[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];                  /* stationarity residual of s */
+    HM_REAL sdr[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sdsb[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];         /* dt dz, ds dzs of the predictor */
+    HM_REAL se[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];                   /* general solve: slack step at a zero position step */
+    HM_REAL p0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], p1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];            /* (px, py) of the row's stage: of the iterate, of the step */
+    HM_REAL dp0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], dp1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
+    /* pass A's per-row parts of the stage's (px, py) block, gradients and A' w; pass C's of hdl */
+    HM_REAL h00[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], h10[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], h11[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], g0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], g1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], m0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], m1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], a0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], a1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
+} HM_NS(ocp_qp_ipm_rows);
 
 /* A vector in the solver's layout (the Newton system's unknowns or right-hand side), used by the
  * general solve of ocp_qp_kkt.h (tests, polish): per stage ux, the soft slacks by soft row, y, and
@@ -299,6 +311,7 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
         struct {
             HM_NS(ocp_qp_ipm_stage) st[HM_N + 1];
             HM_NS(ocp_qp_ipm_bounds) bd;
+            HM_NS(ocp_qp_ipm_rows) sr;
             HM_NS(ocp_qp_ipm_vec) va, vb;
         } f;
         HM_NS(ocp_qp_hsde_ws) hsde;

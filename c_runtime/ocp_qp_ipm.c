@@ -150,7 +150,8 @@ HM_FUNC int ocp_qp_ipm_bounds_of(const hm_ocp_qp *qp, int n, int i, hm_real *lb,
 HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad)
 {
     hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
-    int n, i, j, k, l, m = 0;
+    hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
+    int n, i, j, k, l, m = 0, off = 0;
     int bounded[HM_QP_NUX];
     hm_real norm_q = HM_R(0.0), norm_b = HM_R(0.0), hscale = HM_R(0.0), c;
 
@@ -207,6 +208,7 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
         int ns = 0, nh = 0;
+        sn->soff = off;
         /* general rows: soft ones and hard ones, each in QP order */
         if (n > 0) {
             for (i = 0; i < qp->ng[n]; i++) {
@@ -214,13 +216,13 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
                 if (!ocp_qp_bound_present(lg)) continue;
                 norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(lg));
                 if (qp->soft[n][i]) {
-                    sn->srow[ns] = (unsigned char)i;
-                    sn->sd0[ns] = qp->D[n][i][0];
-                    sn->sd1[ns] = qp->D[n][i][1];
-                    sn->slg[ns] = lg;
-                    sn->szl[ns] = qp->zl[n][i];
-                    sn->sZl[ns] = qp->Zl[n][i];
-                    sn->slive[ns] = HM_R(1.0);
+                    sr->srow[sn->soff + ns] = (unsigned char)i;
+                    sr->sd0[sn->soff + ns] = qp->D[n][i][0];
+                    sr->sd1[sn->soff + ns] = qp->D[n][i][1];
+                    sr->slg[sn->soff + ns] = lg;
+                    sr->szl[sn->soff + ns] = qp->zl[n][i];
+                    sr->sZl[sn->soff + ns] = qp->Zl[n][i];
+                    sr->slive[sn->soff + ns] = HM_R(1.0);
                     norm_q = OCP_QP_IPM_MAX(norm_q, hm_fabs(qp->zl[n][i]));
                     hscale = OCP_QP_IPM_MAX(hscale, hm_fabs(qp->Zl[n][i]));
                     ns++;
@@ -238,6 +240,7 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         sn->nh = nh;
         sn->ns2 = ns + (ns & 1);
         sn->nh2 = nh + (nh & 1);
+        off += sn->ns2;
         m += 2 * ns + nh;
 
         /* cost and dynamics offset, unscaled for now; x_0 is data, its terms move into stage 0 */
@@ -279,6 +282,7 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         }
     }
     ws->m = m;
+    sr->nr = off;
 
     /* Cost scaling (as in Clarabel): a cost measured in hundreds (goal weight 250) or a slack
      * penalty of 1e4 against rows measured in metres. Clipped so that tiny or huge data are not
@@ -309,25 +313,25 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
             sn->dy[i] = HM_R(0.0);
         }
         for (j = 0; j < sn->ns; j++) {
-            const hm_real s = OCP_QP_IPM_MAX(HM_R(0.0), sn->slg[j]) + HM_R(1.0);
-            const hm_real t = OCP_QP_IPM_MAX(s - sn->slg[j], HM_R(1.0));
-            sn->szl[j] *= c;
-            sn->sZl[j] *= c;
-            sn->ss[j] = s;
-            sn->st[j] = t;
-            sn->sz[j] = HM_R(1.0) / t;
-            sn->szs[j] = HM_R(1.0) / s;
+            const hm_real s = OCP_QP_IPM_MAX(HM_R(0.0), sr->slg[sn->soff + j]) + HM_R(1.0);
+            const hm_real t = OCP_QP_IPM_MAX(s - sr->slg[sn->soff + j], HM_R(1.0));
+            sr->szl[sn->soff + j] *= c;
+            sr->sZl[sn->soff + j] *= c;
+            sr->ss[sn->soff + j] = s;
+            sr->st[sn->soff + j] = t;
+            sr->sz[sn->soff + j] = HM_R(1.0) / t;
+            sr->szs[sn->soff + j] = HM_R(1.0) / s;
         }
         if (sn->ns & 1) {
             /* the padding row: no coupling (d = 0), zero residuals at the state (1, 1, 1, 1), which
              * pass A restores every iteration; its steps never shorten the step length */
             j = sn->ns;
-            sn->sd0[j] = sn->sd1[j] = sn->slg[j] = HM_R(0.0);
-            sn->szl[j] = sn->sZl[j] = HM_R(1.0);
-            sn->slive[j] = HM_R(0.0);
-            sn->ss[j] = sn->st[j] = sn->sz[j] = sn->szs[j] = HM_R(1.0);
+            sr->sd0[sn->soff + j] = sr->sd1[sn->soff + j] = sr->slg[sn->soff + j] = HM_R(0.0);
+            sr->szl[sn->soff + j] = sr->sZl[sn->soff + j] = HM_R(1.0);
+            sr->slive[sn->soff + j] = HM_R(0.0);
+            sr->ss[sn->soff + j] = sr->st[sn->soff + j] = sr->sz[sn->soff + j] = sr->szs[sn->soff + j] = HM_R(1.0);
         }
-        for (j = 0; j < sn->ns2; j++) sn->sds[j] = sn->sdt[j] = sn->sdz[j] = sn->sdzs[j] = HM_R(0.0);
+        for (j = 0; j < sn->ns2; j++) sr->sds[sn->soff + j] = sr->sdt[sn->soff + j] = sr->sdz[sn->soff + j] = sr->sdzs[sn->soff + j] = HM_R(0.0);
         for (j = 0; j < sn->nh; j++) {
             const hm_real t = OCP_QP_IPM_MAX(-sn->hlg[j], HM_R(1.0));
             sn->ht[j] = t;
@@ -341,6 +345,16 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
             sn->ht[j] = sn->hz[j] = HM_R(1.0);
         }
         for (j = 0; j < sn->nh2; j++) sn->hdt[j] = sn->hdz[j] = HM_R(0.0);
+    }
+    /* the list's padding rows, absent like a stage's */
+    for (j = sr->nr; j < HM_QP_NR; j++) {
+        sr->srow[j] = 0;
+        sr->sd0[j] = sr->sd1[j] = sr->slg[j] = HM_R(0.0);
+        sr->szl[j] = sr->sZl[j] = HM_R(1.0);
+        sr->slive[j] = HM_R(0.0);
+        sr->ss[j] = sr->st[j] = sr->sz[j] = sr->szs[j] = HM_R(1.0);
+        sr->sds[j] = sr->sdt[j] = sr->sdz[j] = sr->sdzs[j] = HM_R(0.0);
+        sr->p0[j] = sr->p1[j] = sr->dp0[j] = sr->dp1[j] = HM_R(0.0);
     }
     return 0;
 }
@@ -453,6 +467,175 @@ HM_FUNC void ocp_qp_ipm_bound_side_measures(const hm_real *restrict sg, const hm
 }
 
 /* ------------------------------------------------------------------------------------------------
+ * Soft rows, eight rows of the list at a time (ocp_qp_ipm_rows): the same arithmetic for every row,
+ * the stages' parts summed afterwards. Lanes keep the sums and maxima of the passes.
+ * ---------------------------------------------------------------------------------------------- */
+
+#define OCP_QP_IPM_LANES 8
+
+/* rows of the list rounded up to whole blocks of lanes */
+HM_FUNC int ocp_qp_ipm_rows_blocks(const hm_ocp_qp_ipm_rows *sr)
+{
+    return (sr->nr + OCP_QP_IPM_LANES - 1) / OCP_QP_IPM_LANES * OCP_QP_IPM_LANES;
+}
+
+/* Pass A: the step, the weights, the eliminated slack, and per row its parts of the (px, py) block,
+ * of the gradients ha and hmu and of A' w; lanes: t z, b w, q v, v P v, the primal and the slack's
+ * dual residual. */
+HM_FUNC void ocp_qp_ipm_rows_a(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real alpha, hm_real wmax,
+                               hm_real (*restrict lane)[OCP_QP_IPM_LANES])
+{
+    int r0, l;
+    for (r0 = 0; r0 < nrp; r0 += OCP_QP_IPM_LANES) {
+        for (l = 0; l < OCP_QP_IPM_LANES; l++) {
+            const int q = r0 + l;
+            const hm_real msk = sr->slive[q];
+            const hm_real s = msk * (sr->ss[q] + alpha * sr->sds[q]) + (HM_R(1.0) - msk);
+            const hm_real t = msk * (sr->st[q] + alpha * sr->sdt[q]) + (HM_R(1.0) - msk);
+            const hm_real z = msk * (sr->sz[q] + alpha * sr->sdz[q]) + (HM_R(1.0) - msk);
+            const hm_real zs = msk * (sr->szs[q] + alpha * sr->sdzs[q]) + (HM_R(1.0) - msk);
+            const hm_real d0 = sr->sd0[q], d1 = sr->sd1[q], lg = sr->slg[q], Zl = sr->sZl[q];
+            const hm_real gp = d0 * sr->p0[q] + d1 * sr->p1[q];
+            const hm_real rho = lg - gp - s;
+            const hm_real rs = Zl * s + sr->szl[q] - z - zs;
+            const hm_real ia = HM_R(1.0) / (t * z), ib = HM_R(1.0) / (s * zs);
+            const hm_real ti = z * ia, zi = t * ia, si = zs * ib, zsi = s * ib;
+            const hm_real wr = OCP_QP_IPM_MIN(z * ti, wmax), wsl = OCP_QP_IPM_MIN(zs * si, wmax);
+            const hm_real hinv = HM_R(1.0) / (Zl + wr + wsl);
+            const hm_real hw = hinv * wr;
+            const hm_real we = hw * (Zl + wsl);
+            const hm_real e = we * rho + hw * (rs + wsl * s);
+            const hm_real cmu = we * zi - hw * wsl * zsi;
+            sr->ss[q] = s;
+            sr->st[q] = t;
+            sr->sz[q] = z;
+            sr->szs[q] = zs;
+            sr->sti[q] = ti;
+            sr->szi[q] = zi;
+            sr->ssi[q] = si;
+            sr->szsi[q] = zsi;
+            sr->swr[q] = wr;
+            sr->sws[q] = wsl;
+            sr->shi[q] = hinv;
+            sr->srs[q] = rs;
+            sr->h00[q] = we * d0 * d0;
+            sr->h10[q] = we * d0 * d1;
+            sr->h11[q] = we * d1 * d1;
+            sr->g0[q] = -d0 * e;
+            sr->g1[q] = -d1 * e;
+            sr->m0[q] = -d0 * cmu;
+            sr->m1[q] = -d1 * cmu;
+            sr->a0[q] = -d0 * z;
+            sr->a1[q] = -d1 * z;
+            lane[0][l] += msk * (t * z + s * zs);
+            lane[1][l] -= msk * lg * z;
+            lane[2][l] += msk * sr->szl[q] * s;
+            lane[3][l] += msk * Zl * s * s;
+            lane[4][l] = OCP_QP_IPM_MAX(lane[4][l], OCP_QP_IPM_ABS(t + rho));
+            lane[5][l] = OCP_QP_IPM_MAX(lane[5][l], OCP_QP_IPM_ABS(rs));
+        }
+    }
+}
+
+/* Pass C: the predictor's steps from the position steps dp, their products (kept in sdr, sdsb for
+ * the corrector), per row its part of hdl on (px, py) in g0, g1; lanes: the step ratio,
+ * t dz + z dt and dt dz. */
+HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real (*restrict lane)[OCP_QP_IPM_LANES])
+{
+    int r0, l;
+    for (r0 = 0; r0 < nrp; r0 += OCP_QP_IPM_LANES) {
+        for (l = 0; l < OCP_QP_IPM_LANES; l++) {
+            const int q = r0 + l;
+            const hm_real msk = sr->slive[q];
+            const hm_real d0 = sr->sd0[q], d1 = sr->sd1[q];
+            const hm_real s = sr->ss[q], t = sr->st[q], z = sr->sz[q], zs = sr->szs[q];
+            const hm_real wr = sr->swr[q], wsl = sr->sws[q], hinv = sr->shi[q];
+            const hm_real zi = sr->szi[q], zsi = sr->szsi[q];
+            const hm_real hw = hinv * wr, we = hw * (sr->sZl[q] + wsl);
+            const hm_real gd = d0 * sr->dp0[q] + d1 * sr->dp1[q];
+            const hm_real rho = sr->slg[q] - (d0 * sr->p0[q] + d1 * sr->p1[q]) - s;
+            const hm_real ds = hinv * (wr * rho - wsl * s - sr->srs[q]) - hw * gd;
+            const hm_real dz = wr * (rho - gd - ds);
+            const hm_real dzs = -wsl * (s + ds);
+#ifdef OCP_QP_IPM_DT_PRIMAL
+            const hm_real dt = gd + ds - (t + rho);
+#else
+            const hm_real dt = -t - t * dz * zi;
+#endif
+            const hm_real dr = dt * dz, dsb = ds * dzs;
+            const hm_real coef = we * zi * dr - hw * wsl * zsi * dsb;
+            sr->sdr[q] = dr;
+            sr->sdsb[q] = dsb;
+            sr->g0[q] = d0 * coef;
+            sr->g1[q] = d1 * coef;
+            lane[0][l] = OCP_QP_IPM_MAX(lane[0][l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sr->sti[q], -dz * zi),
+                                                                  OCP_QP_IPM_MAX(-ds * sr->ssi[q], -dzs * zsi)));
+            lane[1][l] += msk * (t * dz + z * dt + s * dzs + zs * ds);
+            lane[2][l] += msk * (dr + dsb);
+        }
+    }
+}
+
+/* Pass E: the corrector's steps (target smu, second-order term kdel * (sdr, sdsb)); lane: the step
+ * ratio. */
+HM_FUNC void ocp_qp_ipm_rows_e(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real smu, hm_real kdel,
+                               hm_real *restrict lane)
+{
+    int r0, l;
+    for (r0 = 0; r0 < nrp; r0 += OCP_QP_IPM_LANES) {
+        for (l = 0; l < OCP_QP_IPM_LANES; l++) {
+            const int q = r0 + l;
+            const hm_real d0 = sr->sd0[q], d1 = sr->sd1[q];
+            const hm_real s = sr->ss[q], t = sr->st[q], z = sr->sz[q];
+            const hm_real wr = sr->swr[q], wsl = sr->sws[q], hinv = sr->shi[q];
+            const hm_real zi = sr->szi[q], zsi = sr->szsi[q];
+            const hm_real cr = smu - kdel * sr->sdr[q], cs = smu - kdel * sr->sdsb[q];
+            const hm_real hw = hinv * wr;
+            const hm_real gd = d0 * sr->dp0[q] + d1 * sr->dp1[q];
+            const hm_real rho0 = sr->slg[q] - (d0 * sr->p0[q] + d1 * sr->p1[q]) - s;
+            const hm_real rho = rho0 + cr * zi;
+            const hm_real rhos = cs * zsi - s;
+            const hm_real ds = hinv * (wr * rho + wsl * rhos - sr->srs[q]) - hw * gd;
+            const hm_real dz = wr * (rho - gd - ds);
+            const hm_real dzs = wsl * (rhos - ds);
+#ifdef OCP_QP_IPM_DT_PRIMAL
+            const hm_real dt = gd + ds - (t + rho0);
+            (void)z;
+#else
+            const hm_real dt = -(t * z - cr + t * dz) * zi;
+#endif
+            sr->sds[q] = ds;
+            sr->sdt[q] = dt;
+            sr->sdz[q] = dz;
+            sr->sdzs[q] = dzs;
+            lane[l] = OCP_QP_IPM_MAX(lane[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sr->sti[q], -dz * zi),
+                                                             OCP_QP_IPM_MAX(-ds * sr->ssi[q], -dzs * zsi)));
+        }
+    }
+}
+
+/* The termination tests' measures over the live rows (padding rows masked to 0): |A_I v + t|, t,
+ * min(t, z) and min(s, zs), the slack's A' w and P v. */
+HM_FUNC void ocp_qp_ipm_rows_measures(const hm_ocp_qp_ipm_rows *restrict sr, int nrp,
+                                      hm_real (*restrict lane)[OCP_QP_IPM_LANES])
+{
+    int r0, l;
+    for (r0 = 0; r0 < nrp; r0 += OCP_QP_IPM_LANES) {
+        for (l = 0; l < OCP_QP_IPM_LANES; l++) {
+            const int q = r0 + l;
+            const hm_real msk = sr->slive[q];
+            const hm_real t = sr->st[q], z = sr->sz[q], s = sr->ss[q], zs = sr->szs[q];
+            const hm_real av = t - (sr->sd0[q] * sr->p0[q] + sr->sd1[q] * sr->p1[q]) - s;
+            lane[0][l] = OCP_QP_IPM_MAX(lane[0][l], msk * OCP_QP_IPM_ABS(av));
+            lane[1][l] = OCP_QP_IPM_MAX(lane[1][l], msk * t);
+            lane[2][l] = OCP_QP_IPM_MAX(lane[2][l], msk * OCP_QP_IPM_MAX(OCP_QP_IPM_MIN(t, z), OCP_QP_IPM_MIN(s, zs)));
+            lane[3][l] = OCP_QP_IPM_MAX(lane[3][l], msk * (z + zs));
+            lane[4][l] = OCP_QP_IPM_MAX(lane[4][l], msk * OCP_QP_IPM_ABS(sr->sZl[q] * s));
+        }
+    }
+}
+
+/* ------------------------------------------------------------------------------------------------
  * Pass A: step, residuals, weights, condensation
  * ---------------------------------------------------------------------------------------------- */
 
@@ -507,6 +690,7 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
      * numbers (max is exact in any order), in vector lanes instead of one scalar chain. */
     hm_real rd_v[HM_QP_NUX], pv_v[HM_QP_NUX], atw_v[HM_QP_NUX], eq_v[HM_NX], rpe_v[HM_NX];
     hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
+    hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
     int n, i, j, k, l;
 
     for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = pv_v[i] = atw_v[i] = HM_R(0.0);
@@ -520,6 +704,26 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         for (i = 0; i < HM_QP_NUX; i++) sn->ux[i] += alpha * sn->dux[i];
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) sn->y[i] += alpha * sn->dy[i];
+        }
+        for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
+            sr->p0[j] = sn->ux[HM_NU];
+            sr->p1[j] = sn->ux[HM_NU + 1];
+        }
+    }
+
+    /* soft rows, all at once; their parts of the stages are summed in the stage loop */
+    {
+        hm_real lane[6][OCP_QP_IPM_LANES];
+        for (l = 0; l < OCP_QP_IPM_LANES; l++)
+            lane[0][l] = lane[1][l] = lane[2][l] = lane[3][l] = lane[4][l] = lane[5][l] = HM_R(0.0);
+        ocp_qp_ipm_rows_a(sr, ocp_qp_ipm_rows_blocks(sr), alpha, wmax, lane);
+        for (l = 0; l < OCP_QP_IPM_LANES; l++) {
+            tz += lane[0][l];
+            bw += lane[1][l];
+            qv += lane[2][l];
+            vPv += lane[3][l];
+            rp = OCP_QP_IPM_MAX(rp, lane[4][l]);
+            rd = OCP_QP_IPM_MAX(rd, lane[5][l]);
         }
     }
 
@@ -630,55 +834,17 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             hm_real qv_l[2] = {HM_R(0.0), HM_R(0.0)}, vPv_l[2] = {HM_R(0.0), HM_R(0.0)};
             hm_real rp_l[2] = {HM_R(0.0), HM_R(0.0)}, rd_l[2] = {HM_R(0.0), HM_R(0.0)};
 
-            /* soft rows, in pairs */
-            for (j = 0; j < sn->ns2; j += 2) {
-                for (l = 0; l < 2; l++) {
-                    const int q = j + l;
-                    const hm_real msk = sn->slive[q];
-                    const hm_real s = msk * (sn->ss[q] + alpha * sn->sds[q]) + (HM_R(1.0) - msk);
-                    const hm_real t = msk * (sn->st[q] + alpha * sn->sdt[q]) + (HM_R(1.0) - msk);
-                    const hm_real z = msk * (sn->sz[q] + alpha * sn->sdz[q]) + (HM_R(1.0) - msk);
-                    const hm_real zs = msk * (sn->szs[q] + alpha * sn->sdzs[q]) + (HM_R(1.0) - msk);
-                    const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q], lg = sn->slg[q], Zl = sn->sZl[q];
-                    const hm_real gp = d0 * p0 + d1 * p1;
-                    const hm_real rho = lg - gp - s;
-                    const hm_real rs = Zl * s + sn->szl[q] - z - zs;
-                    const hm_real ia = HM_R(1.0) / (t * z), ib = HM_R(1.0) / (s * zs);
-                    const hm_real ti = z * ia, zi = t * ia, si = zs * ib, zsi = s * ib;
-                    const hm_real wr = OCP_QP_IPM_MIN(z * ti, wmax), wsl = OCP_QP_IPM_MIN(zs * si, wmax);
-                    const hm_real hinv = HM_R(1.0) / (Zl + wr + wsl);
-                    const hm_real hw = hinv * wr;
-                    const hm_real we = hw * (Zl + wsl);
-                    const hm_real e = we * rho + hw * (rs + wsl * s);
-                    const hm_real cmu = we * zi - hw * wsl * zsi;
-                    sn->ss[q] = s;
-                    sn->st[q] = t;
-                    sn->sz[q] = z;
-                    sn->szs[q] = zs;
-                    sn->sti[q] = ti;
-                    sn->szi[q] = zi;
-                    sn->ssi[q] = si;
-                    sn->szsi[q] = zsi;
-                    sn->swr[q] = wr;
-                    sn->sws[q] = wsl;
-                    sn->shi[q] = hinv;
-                    sn->srs[q] = rs;
-                    h00[l] += we * d0 * d0;
-                    h10[l] += we * d0 * d1;
-                    h11[l] += we * d1 * d1;
-                    g0[l] -= d0 * e;
-                    g1[l] -= d1 * e;
-                    m0[l] -= d0 * cmu;
-                    m1[l] -= d1 * cmu;
-                    a0[l] -= d0 * z;
-                    a1[l] -= d1 * z;
-                    tz_l[l] += msk * (t * z + s * zs);
-                    bw_l[l] -= msk * lg * z;
-                    qv_l[l] += msk * sn->szl[q] * s;
-                    vPv_l[l] += msk * Zl * s * s;
-                    rp_l[l] = OCP_QP_IPM_MAX(rp_l[l], OCP_QP_IPM_ABS(t + rho));
-                    rd_l[l] = OCP_QP_IPM_MAX(rd_l[l], OCP_QP_IPM_ABS(rs));
-                }
+            /* soft rows (ocp_qp_ipm_rows_a, above): their parts summed into the stage */
+            for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
+                h00[0] += sr->h00[j];
+                h10[0] += sr->h10[j];
+                h11[0] += sr->h11[j];
+                g0[0] += sr->g0[j];
+                g1[0] += sr->g1[j];
+                m0[0] += sr->m0[j];
+                m1[0] += sr->m1[j];
+                a0[0] += sr->a0[j];
+                a1[0] += sr->a1[j];
             }
             /* hard rows, in pairs */
             for (j = 0; j < sn->nh2; j += 2) {
@@ -780,6 +946,7 @@ HM_FUNC void ocp_qp_ipm_row_measures(const hm_ocp_qp_ipm_ws *restrict ws, ocp_qp
     /* bound lanes: maxima per lane (as in pass A), absent sides masked to zero */
     hm_real avb[HM_QP_NNP], ntb[HM_QP_NNP], ncrb[HM_QP_NNP];
     const hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
+    const hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
     int n, k, l, j;
     for (n = 0; n < HM_QP_NNP; n++) avb[n] = ntb[n] = ncrb[n] = HM_R(0.0);
     for (k = 0; k < bd->nbp; k++) {
@@ -791,18 +958,24 @@ HM_FUNC void ocp_qp_ipm_row_measures(const hm_ocp_qp_ipm_ws *restrict ws, ocp_qp
         nt = OCP_QP_IPM_MAX(nt, ntb[n]);
         ncr = OCP_QP_IPM_MAX(ncr, ncrb[n]);
     }
+    /* soft rows, all at once (the padding rows masked) */
+    {
+        hm_real lane[5][OCP_QP_IPM_LANES];
+        for (l = 0; l < OCP_QP_IPM_LANES; l++)
+            lane[0][l] = lane[1][l] = lane[2][l] = lane[3][l] = lane[4][l] = HM_R(0.0);
+        ocp_qp_ipm_rows_measures(sr, ocp_qp_ipm_rows_blocks(sr), lane);
+        for (l = 0; l < OCP_QP_IPM_LANES; l++) {
+            av = OCP_QP_IPM_MAX(av, lane[0][l]);
+            nt = OCP_QP_IPM_MAX(nt, lane[1][l]);
+            ncr = OCP_QP_IPM_MAX(ncr, lane[2][l]);
+            atw_s = OCP_QP_IPM_MAX(atw_s, lane[3][l]);
+            pv_s = OCP_QP_IPM_MAX(pv_s, lane[4][l]);
+        }
+    }
     for (n = 0; n <= HM_N; n++) {
         const hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
         const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
         if (n == 0) continue;
-        for (j = 0; j < sn->ns; j++) {
-            const hm_real t = sn->st[j], z = sn->sz[j], s = sn->ss[j], zs = sn->szs[j];
-            av = OCP_QP_IPM_MAX(av, OCP_QP_IPM_ABS(t - (sn->sd0[j] * p0 + sn->sd1[j] * p1) - s));
-            nt = OCP_QP_IPM_MAX(nt, t);
-            ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MAX(OCP_QP_IPM_MIN(t, z), OCP_QP_IPM_MIN(s, zs)));
-            atw_s = OCP_QP_IPM_MAX(atw_s, z + zs);
-            pv_s = OCP_QP_IPM_MAX(pv_s, OCP_QP_IPM_ABS(sn->sZl[j] * s));
-        }
         for (j = 0; j < sn->nh; j++) {
             const hm_real t = sn->ht[j], z = sn->hz[j];
             av = OCP_QP_IPM_MAX(av, OCP_QP_IPM_ABS(t - (sn->hd0[j] * p0 + sn->hd1[j] * p1)));
@@ -879,6 +1052,7 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
     hm_real dy[HM_NX];
     hm_real ratio = HM_R(0.0), tdz = HM_R(0.0), dtdz = HM_R(0.0);
     hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
+    hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
     int n, i, j, k, l;
     /* the predictor's step lives in the stages' dux until pass E writes the corrector's over it
      * (pass A has taken the last one) */
@@ -897,37 +1071,6 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                 const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
                 hm_real g0[2] = {HM_R(0.0), HM_R(0.0)}, g1[2] = {HM_R(0.0), HM_R(0.0)};
                 hm_real ra[2] = {HM_R(0.0), HM_R(0.0)}, sa[2] = {HM_R(0.0), HM_R(0.0)}, sb[2] = {HM_R(0.0), HM_R(0.0)};
-                for (j = 0; j < sn->ns2; j += 2) {
-                    for (l = 0; l < 2; l++) {
-                        const int q = j + l;
-                        const hm_real msk = sn->slive[q];
-                        const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q];
-                        const hm_real s = sn->ss[q], t = sn->st[q], z = sn->sz[q], zs = sn->szs[q];
-                        const hm_real wr = sn->swr[q], wsl = sn->sws[q], hinv = sn->shi[q];
-                        const hm_real zi = sn->szi[q], zsi = sn->szsi[q];
-                        const hm_real hw = hinv * wr, we = hw * (sn->sZl[q] + wsl);
-                        const hm_real gd = d0 * dp0 + d1 * dp1;
-                        const hm_real rho = sn->slg[q] - (d0 * p0 + d1 * p1) - s;
-                        const hm_real ds = hinv * (wr * rho - wsl * s - sn->srs[q]) - hw * gd;
-                        const hm_real dz = wr * (rho - gd - ds);
-                        const hm_real dzs = -wsl * (s + ds);
-    #ifdef OCP_QP_IPM_DT_PRIMAL
-                        const hm_real dt = gd + ds - (t + rho);
-    #else
-                        const hm_real dt = -t - t * dz * zi;
-    #endif
-                        const hm_real dr = dt * dz, dsb = ds * dzs;
-                        const hm_real coef = we * zi * dr - hw * wsl * zsi * dsb;
-                        sn->sdr[q] = dr;
-                        sn->sdsb[q] = dsb;
-                        g0[l] += d0 * coef;
-                        g1[l] += d1 * coef;
-                        ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sn->sti[q], -dz * zi),
-                                                                      OCP_QP_IPM_MAX(-ds * sn->ssi[q], -dzs * zsi)));
-                        sa[l] += msk * (t * dz + z * dt + s * dzs + zs * ds);
-                        sb[l] += msk * (dr + dsb);
-                    }
-                }
                 for (j = 0; j < sn->nh2; j += 2) {
                     for (l = 0; l < 2; l++) {
                         const int q = j + l;
@@ -963,6 +1106,24 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             sn->hdl[HM_NU + 1] = hdl1;
         }
     }
+    /* soft rows, all at once, from the position steps of their stages; their parts of hdl below */
+    {
+        hm_real lane[3][OCP_QP_IPM_LANES];
+        for (n = 1; n <= HM_N; n++) {
+            const hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+            for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
+                sr->dp0[j] = sn->dux[HM_NU];
+                sr->dp1[j] = sn->dux[HM_NU + 1];
+            }
+        }
+        for (l = 0; l < OCP_QP_IPM_LANES; l++) lane[0][l] = lane[1][l] = lane[2][l] = HM_R(0.0);
+        ocp_qp_ipm_rows_c(sr, ocp_qp_ipm_rows_blocks(sr), lane);
+        for (l = 0; l < OCP_QP_IPM_LANES; l++) {
+            ratio = OCP_QP_IPM_MAX(ratio, lane[0][l]);
+            tdz += lane[1][l];
+            dtdz += lane[2][l];
+        }
+    }
     /* bound pairs, all stages of a slot at once */
     {
         hm_real r_v[HM_QP_NNP], tdz_v[HM_QP_NNP], dtdz_v[HM_QP_NNP];
@@ -980,9 +1141,18 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             tdz += tdz_v[n];
             dtdz += dtdz_v[n];
         }
-        /* into the stages' hdl, which pass D reads (off its sequential chain here) */
+        /* into the stages' hdl, which pass D reads (off its sequential chain here), with the soft
+         * rows' parts */
         for (n = 0; n <= HM_N; n++) {
-            hm_real *restrict hdl = ws->u.f.st[n].hdl;
+            hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+            hm_real *restrict hdl = sn->hdl;
+            hm_real h0 = HM_R(0.0), h1 = HM_R(0.0);
+            for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
+                h0 += sr->g0[j];
+                h1 += sr->g1[j];
+            }
+            hdl[HM_NU] += h0;
+            hdl[HM_NU + 1] += h1;
             for (k = 0; k < bd->nbp; k++) hdl[bd->bc[k]] += bd->hdl[k][n];
         }
     }
@@ -998,6 +1168,7 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
 {
     hm_real ratio = HM_R(0.0);
     hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
+    hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
     int n, i, j, k, l;
     for (i = 0; i < HM_NX; i++) ws->u.f.st[0].dux[HM_NU + i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
@@ -1010,36 +1181,6 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
                 const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
                 const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
                 hm_real ra[2] = {HM_R(0.0), HM_R(0.0)};
-                for (j = 0; j < sn->ns2; j += 2) {
-                    for (l = 0; l < 2; l++) {
-                        const int q = j + l;
-                        const hm_real d0 = sn->sd0[q], d1 = sn->sd1[q];
-                        const hm_real s = sn->ss[q], t = sn->st[q], z = sn->sz[q];
-                        const hm_real wr = sn->swr[q], wsl = sn->sws[q], hinv = sn->shi[q];
-                        const hm_real zi = sn->szi[q], zsi = sn->szsi[q];
-                        const hm_real cr = smu - kdel * sn->sdr[q], cs = smu - kdel * sn->sdsb[q];
-                        const hm_real hw = hinv * wr;
-                        const hm_real gd = d0 * dp0 + d1 * dp1;
-                        const hm_real rho0 = sn->slg[q] - (d0 * p0 + d1 * p1) - s;
-                        const hm_real rho = rho0 + cr * zi;
-                        const hm_real rhos = cs * zsi - s;
-                        const hm_real ds = hinv * (wr * rho + wsl * rhos - sn->srs[q]) - hw * gd;
-                        const hm_real dz = wr * (rho - gd - ds);
-                        const hm_real dzs = wsl * (rhos - ds);
-    #ifdef OCP_QP_IPM_DT_PRIMAL
-                        const hm_real dt = gd + ds - (t + rho0);
-                        (void)z;
-    #else
-                        const hm_real dt = -(t * z - cr + t * dz) * zi;
-    #endif
-                        sn->sds[q] = ds;
-                        sn->sdt[q] = dt;
-                        sn->sdz[q] = dz;
-                        sn->sdzs[q] = dzs;
-                        ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sn->sti[q], -dz * zi),
-                                                                      OCP_QP_IPM_MAX(-ds * sn->ssi[q], -dzs * zsi)));
-                    }
-                }
                 for (j = 0; j < sn->nh2; j += 2) {
                     for (l = 0; l < 2; l++) {
                         const int q = j + l;
@@ -1064,6 +1205,20 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
             }
         }
     }
+    /* soft rows, all at once */
+    {
+        hm_real lane[OCP_QP_IPM_LANES];
+        for (n = 1; n <= HM_N; n++) {
+            const hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+            for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
+                sr->dp0[j] = sn->dux[HM_NU];
+                sr->dp1[j] = sn->dux[HM_NU + 1];
+            }
+        }
+        for (l = 0; l < OCP_QP_IPM_LANES; l++) lane[l] = HM_R(0.0);
+        ocp_qp_ipm_rows_e(sr, ocp_qp_ipm_rows_blocks(sr), smu, kdel, lane);
+        for (l = 0; l < OCP_QP_IPM_LANES; l++) ratio = OCP_QP_IPM_MAX(ratio, lane[l]);
+    }
     /* bound pairs, all stages of a slot at once */
     {
         hm_real r_v[HM_QP_NNP];
@@ -1086,7 +1241,8 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
 
 /* Multipliers and slacks of stage n into sol from the given inequality values (stage blocks or a
  * vector); sc scales the multipliers, sp the slacks. */
-HM_FUNC void ocp_qp_ipm_write_stage(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd, int n,
+HM_FUNC void ocp_qp_ipm_write_stage(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd,
+                                    const hm_ocp_qp_ipm_rows *sr, int n,
                                     hm_ocp_qp_sol *sol,
                                     const hm_real (*zb)[2], const hm_real *s, const hm_real *zr,
                                     const hm_real *zs, const hm_real *zh, hm_real sc, hm_real sp)
@@ -1123,7 +1279,7 @@ HM_FUNC void ocp_qp_ipm_write_stage(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_
         }
     }
     for (j = 0; j < sn->ns; j++) {
-        const int i_row = sn->srow[j];
+        const int i_row = sr->srow[sn->soff + j];
         sol->s[n][i_row] = sp * s[j];
         sol->lam_lg[n][i_row] = sc * zr[j];
         sol->lam_ls[n][i_row] = sc * zs[j];
@@ -1153,7 +1309,8 @@ HM_FUNC void ocp_qp_ipm_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *w
             zb[k][0] = ws->u.f.bd.z[k][0][n];
             zb[k][1] = ws->u.f.bd.z[k][1][n];
         }
-        ocp_qp_ipm_write_stage(sn, &ws->u.f.bd, n, sol, (const hm_real (*)[2])zb, sn->ss, sn->sz, sn->szs, sn->hz,
+        ocp_qp_ipm_write_stage(sn, &ws->u.f.bd, &ws->u.f.sr, n, sol, (const hm_real (*)[2])zb,
+                               &ws->u.f.sr.ss[sn->soff], &ws->u.f.sr.sz[sn->soff], &ws->u.f.sr.szs[sn->soff], sn->hz,
                                sc, sp);
     }
 }
@@ -1172,7 +1329,7 @@ HM_FUNC void ocp_qp_ipm_write_sol_vec(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_w
         if (n > 0) {
             for (i = 0; i < HM_NX; i++) sol->x[n][i] = v->ux[n][HM_NU + i];
         }
-        ocp_qp_ipm_write_stage(&ws->u.f.st[n], &ws->u.f.bd, n, sol, (const hm_real (*)[2])v->zb[n], v->s[n], v->zr[n],
+        ocp_qp_ipm_write_stage(&ws->u.f.st[n], &ws->u.f.bd, &ws->u.f.sr, n, sol, (const hm_real (*)[2])v->zb[n], v->s[n], v->zr[n],
                                v->zs[n], v->zh[n], sc, HM_R(1.0));
     }
 }
@@ -1183,6 +1340,7 @@ HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, c
                               hm_real tol_infeas, hm_real *bw_out)
 {
     const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
     hm_real bw = HM_R(0.0), atw_n = HM_R(0.0);
     int n, i, k, j, l;
     for (n = 0; n <= HM_N; n++) {
@@ -1211,9 +1369,9 @@ HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, c
         }
         for (j = 0; j < sn->ns; j++) {
             const hm_real as = OCP_QP_IPM_ABS(w->zr[n][j] + w->zs[n][j]);
-            atw[HM_NU] -= sn->sd0[j] * w->zr[n][j];
-            atw[HM_NU + 1] -= sn->sd1[j] * w->zr[n][j];
-            bw -= sn->slg[j] * w->zr[n][j];
+            atw[HM_NU] -= sr->sd0[sn->soff + j] * w->zr[n][j];
+            atw[HM_NU + 1] -= sr->sd1[sn->soff + j] * w->zr[n][j];
+            bw -= sr->slg[sn->soff + j] * w->zr[n][j];
             atw_n = OCP_QP_IPM_MAX(atw_n, as);
         }
         for (j = 0; j < sn->nh; j++) {
@@ -1233,6 +1391,7 @@ HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, c
 HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, hm_real tol_infeas)
 {
     const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
     const hm_real cinv = HM_R(1.0) / ws->cost_scale;
     hm_real qd = HM_R(0.0), pd = HM_R(0.0), ad = HM_R(0.0);
     int n, i, k, j, l;
@@ -1263,10 +1422,10 @@ HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws
             for (l = 0; l < 2; l++) ad = OCP_QP_IPM_MAX(ad, bd->sg[k][l][n] * d[bd->bc[k]]);
         }
         for (j = 0; j < sn->ns; j++) {
-            const hm_real gd = sn->sd0[j] * d[HM_NU] + sn->sd1[j] * d[HM_NU + 1];
-            qd += sn->szl[j] * sn->sds[j];
-            pd = OCP_QP_IPM_MAX(pd, OCP_QP_IPM_ABS(sn->sZl[j] * sn->sds[j]));
-            ad = OCP_QP_IPM_MAX(ad, OCP_QP_IPM_MAX(-(gd + sn->sds[j]), -sn->sds[j]));
+            const hm_real gd = sr->sd0[sn->soff + j] * d[HM_NU] + sr->sd1[sn->soff + j] * d[HM_NU + 1];
+            qd += sr->szl[sn->soff + j] * sr->sds[sn->soff + j];
+            pd = OCP_QP_IPM_MAX(pd, OCP_QP_IPM_ABS(sr->sZl[sn->soff + j] * sr->sds[sn->soff + j]));
+            ad = OCP_QP_IPM_MAX(ad, OCP_QP_IPM_MAX(-(gd + sr->sds[sn->soff + j]), -sr->sds[sn->soff + j]));
         }
         for (j = 0; j < sn->nh; j++) ad = OCP_QP_IPM_MAX(ad, -(sn->hd0[j] * d[HM_NU] + sn->hd1[j] * d[HM_NU + 1]));
     }
@@ -1279,6 +1438,7 @@ HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws
 HM_FUNC void ocp_qp_ipm_ray_from_step(hm_ocp_qp_ipm_ws *ws)
 {
     const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
     hm_ocp_qp_ipm_vec *v = &ws->u.f.va;
     int n, i, k, j, l;
     for (n = 0; n <= HM_N; n++) {
@@ -1292,8 +1452,8 @@ HM_FUNC void ocp_qp_ipm_ray_from_step(hm_ocp_qp_ipm_ws *ws)
         }
         for (j = 0; j < sn->ns; j++) {
             v->s[n][j] = HM_R(0.0);
-            v->zr[n][j] = OCP_QP_IPM_MAX(sn->sdz[j], HM_R(0.0));
-            v->zs[n][j] = OCP_QP_IPM_MAX(sn->sdzs[j], HM_R(0.0));
+            v->zr[n][j] = OCP_QP_IPM_MAX(sr->sdz[sn->soff + j], HM_R(0.0));
+            v->zs[n][j] = OCP_QP_IPM_MAX(sr->sdzs[sn->soff + j], HM_R(0.0));
         }
         for (j = 0; j < sn->nh; j++) v->zh[n][j] = OCP_QP_IPM_MAX(sn->hdz[j], HM_R(0.0));
     }
@@ -1311,6 +1471,7 @@ HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm
                                         const hm_ocp_qp_ipm_vec *d, hm_ocp_qp_ipm_vec *e)
 {
     const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
     const hm_real wmax = ws->w_max;
     int n, i, k, j, l;
     for (n = 0; n <= HM_N; n++) {
@@ -1350,13 +1511,13 @@ HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm
             }
         }
         for (j = 0; j < sn->ns; j++) {
-            const hm_real gp = sn->sd0[j] * ux[HM_NU] + sn->sd1[j] * ux[HM_NU + 1];
-            const hm_real tr = sn->swr[j] < wmax ? -d->zr[n][j] / sn->swr[j] : HM_R(0.0);
-            const hm_real ts = sn->sws[j] < wmax ? -d->zs[n][j] / sn->sws[j] : HM_R(0.0);
-            r[HM_NU] -= sn->sd0[j] * d->zr[n][j];
-            r[HM_NU + 1] -= sn->sd1[j] * d->zr[n][j];
-            e->s[n][j] = -(sn->sZl[j] * d->s[n][j] + sn->szl[j] - d->zr[n][j] - d->zs[n][j]);
-            e->zr[n][j] = -(tr - gp - d->s[n][j] + sn->slg[j]);
+            const hm_real gp = sr->sd0[sn->soff + j] * ux[HM_NU] + sr->sd1[sn->soff + j] * ux[HM_NU + 1];
+            const hm_real tr = sr->swr[sn->soff + j] < wmax ? -d->zr[n][j] / sr->swr[sn->soff + j] : HM_R(0.0);
+            const hm_real ts = sr->sws[sn->soff + j] < wmax ? -d->zs[n][j] / sr->sws[sn->soff + j] : HM_R(0.0);
+            r[HM_NU] -= sr->sd0[sn->soff + j] * d->zr[n][j];
+            r[HM_NU + 1] -= sr->sd1[sn->soff + j] * d->zr[n][j];
+            e->s[n][j] = -(sr->sZl[sn->soff + j] * d->s[n][j] + sr->szl[sn->soff + j] - d->zr[n][j] - d->zs[n][j]);
+            e->zr[n][j] = -(tr - gp - d->s[n][j] + sr->slg[sn->soff + j]);
             e->zs[n][j] = -(ts - d->s[n][j]);
         }
         for (j = 0; j < sn->nh; j++) {
@@ -1443,6 +1604,7 @@ HM_FUNC int ocp_qp_ipm_undecided_pair(hm_real t, hm_real z, hm_real dt, hm_real 
 HM_FUNC int ocp_qp_ipm_undecided(const hm_ocp_qp_ipm_ws *ws, hm_real alpha)
 {
     const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
     int n, k, l, j;
     if (!(alpha > HM_R(0.0))) return 0;
     for (n = 0; n <= HM_N; n++) {
@@ -1456,8 +1618,8 @@ HM_FUNC int ocp_qp_ipm_undecided(const hm_ocp_qp_ipm_ws *ws, hm_real alpha)
             }
         }
         for (j = 0; j < sn->ns; j++) {
-            if (ocp_qp_ipm_undecided_pair(sn->st[j], sn->sz[j], sn->sdt[j], sn->sdz[j], alpha)
-                || ocp_qp_ipm_undecided_pair(sn->ss[j], sn->szs[j], sn->sds[j], sn->sdzs[j], alpha))
+            if (ocp_qp_ipm_undecided_pair(sr->st[sn->soff + j], sr->sz[sn->soff + j], sr->sdt[sn->soff + j], sr->sdz[sn->soff + j], alpha)
+                || ocp_qp_ipm_undecided_pair(sr->ss[sn->soff + j], sr->szs[sn->soff + j], sr->sds[sn->soff + j], sr->sdzs[sn->soff + j], alpha))
                 return 1;
         }
         for (j = 0; j < sn->nh; j++) {
@@ -1481,6 +1643,7 @@ HM_FUNC int ocp_qp_ipm_undecided(const hm_ocp_qp_ipm_ws *ws, hm_real alpha)
 HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws, hm_real alpha)
 {
     hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
     hm_ocp_qp_ipm_vec *d = &ws->u.f.va;
     hm_ocp_qp_ipm_vec *e = &ws->u.f.vb;
     const hm_real wmax = ws->w_max;
@@ -1503,8 +1666,8 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
             }
         }
         for (j = 0; j < sn->ns; j++) {
-            sn->swr[j] = ocp_qp_ipm_polish_active(sn->st[j], sn->sz[j], sn->sdt[j], sn->sdz[j], alpha) ? wmax : w_drop;
-            sn->sws[j] = ocp_qp_ipm_polish_active(sn->ss[j], sn->szs[j], sn->sds[j], sn->sdzs[j], alpha) ? wmax : w_drop;
+            sr->swr[sn->soff + j] = ocp_qp_ipm_polish_active(sr->st[sn->soff + j], sr->sz[sn->soff + j], sr->sdt[sn->soff + j], sr->sdz[sn->soff + j], alpha) ? wmax : w_drop;
+            sr->sws[sn->soff + j] = ocp_qp_ipm_polish_active(sr->ss[sn->soff + j], sr->szs[sn->soff + j], sr->sds[sn->soff + j], sr->sdzs[sn->soff + j], alpha) ? wmax : w_drop;
         }
         for (j = 0; j < sn->nh; j++)
             sn->hw[j] = ocp_qp_ipm_polish_active(sn->ht[j], sn->hz[j], sn->hdt[j], sn->hdz[j], alpha) ? wmax : w_drop;
@@ -1529,8 +1692,8 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
                 e->zb[n][k][1] = bd->b[k][1][n];
             }
             for (j = 0; j < sn->ns; j++) {
-                e->s[n][j] = -sn->szl[j];
-                e->zr[n][j] = -sn->slg[j];
+                e->s[n][j] = -sr->szl[sn->soff + j];
+                e->zr[n][j] = -sr->slg[sn->soff + j];
                 e->zs[n][j] = HM_R(0.0);
             }
             for (j = 0; j < sn->nh; j++) e->zh[n][j] = -sn->hlg[j];
@@ -1553,9 +1716,9 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
                 }
             }
             for (j = 0; j < sn->ns; j++) {
-                const hm_real g = sn->sd0[j] * v[HM_NU] + sn->sd1[j] * v[HM_NU + 1] + d->s[n][j] - sn->slg[j];
-                sn->swr[j] = ocp_qp_ipm_polish_weight(sn->swr[j], &d->zr[n][j], g, wmax, w_drop, &changed);
-                sn->sws[j] = ocp_qp_ipm_polish_weight(sn->sws[j], &d->zs[n][j], d->s[n][j], wmax, w_drop, &changed);
+                const hm_real g = sr->sd0[sn->soff + j] * v[HM_NU] + sr->sd1[sn->soff + j] * v[HM_NU + 1] + d->s[n][j] - sr->slg[sn->soff + j];
+                sr->swr[sn->soff + j] = ocp_qp_ipm_polish_weight(sr->swr[sn->soff + j], &d->zr[n][j], g, wmax, w_drop, &changed);
+                sr->sws[sn->soff + j] = ocp_qp_ipm_polish_weight(sr->sws[sn->soff + j], &d->zs[n][j], d->s[n][j], wmax, w_drop, &changed);
             }
             for (j = 0; j < sn->nh; j++) {
                 const hm_real g = sn->hd0[j] * v[HM_NU] + sn->hd1[j] * v[HM_NU + 1] - sn->hlg[j];

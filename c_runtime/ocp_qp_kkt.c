@@ -367,6 +367,7 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp
 HM_FUNC void ocp_qp_kkt_condense_weights(hm_ocp_qp_ipm_ws *ws)
 {
     const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
     int n, k, j;
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
@@ -381,13 +382,13 @@ HM_FUNC void ocp_qp_kkt_condense_weights(hm_ocp_qp_ipm_ws *ws)
             /* a soft row with weight wr, slack-bound weight ws and slack Hessian Zl acts like a hard
              * row of weight wr (Zl + ws) / (Zl + wr + ws) (the two in series; as a product, not as
              * wr - wr^2 / (...), which cancels when wr is large) */
-            const hm_real hinv = HM_R(1.0) / (sn->sZl[j] + sn->swr[j] + sn->sws[j]);
-            const hm_real we = sn->swr[j] * (sn->sZl[j] + sn->sws[j]) * hinv;
-            const hm_real wd0 = we * sn->sd0[j];
-            sn->shi[j] = hinv;
-            h00 += wd0 * sn->sd0[j];
-            h10 += wd0 * sn->sd1[j];
-            h11 += we * sn->sd1[j] * sn->sd1[j];
+            const hm_real hinv = HM_R(1.0) / (sr->sZl[sn->soff + j] + sr->swr[sn->soff + j] + sr->sws[sn->soff + j]);
+            const hm_real we = sr->swr[sn->soff + j] * (sr->sZl[sn->soff + j] + sr->sws[sn->soff + j]) * hinv;
+            const hm_real wd0 = we * sr->sd0[sn->soff + j];
+            sr->shi[sn->soff + j] = hinv;
+            h00 += wd0 * sr->sd0[sn->soff + j];
+            h10 += wd0 * sr->sd1[sn->soff + j];
+            h11 += we * sr->sd1[sn->soff + j] * sr->sd1[sn->soff + j];
         }
         for (j = 0; j < sn->nh; j++) {
             const hm_real wd0 = sn->hw[j] * sn->hd0[j];
@@ -413,8 +414,8 @@ HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws)
 
 /* Gradient of the condensed stage QP for a general right-hand side: h = -(rhs_v + A_I' W rhs_z)
  * with the soft slacks folded in (their step at a zero position step into e). */
-HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd, const hm_ocp_qp_ipm_vec *rhs,
-                                 int n, hm_real *h)
+HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd, hm_ocp_qp_ipm_rows *sr,
+                                 const hm_ocp_qp_ipm_vec *rhs, int n, hm_real *h)
 {
     hm_real hp0 = HM_R(0.0), hp1 = HM_R(0.0);
     int i, k, j;
@@ -425,12 +426,12 @@ HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bo
                 + bd->sg[k][1][n] * bd->w[k][1][n] * rhs->zb[n][k][1];
     }
     for (j = 0; j < sn->ns; j++) {
-        hm_real coef = sn->swr[j] * rhs->zr[n][j];
-        const hm_real ej = (rhs->s[n][j] - coef - sn->sws[j] * rhs->zs[n][j]) * sn->shi[j];
-        sn->se[j] = ej;
-        coef += sn->swr[j] * ej;
-        hp0 += coef * sn->sd0[j];
-        hp1 += coef * sn->sd1[j];
+        hm_real coef = sr->swr[sn->soff + j] * rhs->zr[n][j];
+        const hm_real ej = (rhs->s[n][j] - coef - sr->sws[sn->soff + j] * rhs->zs[n][j]) * sr->shi[sn->soff + j];
+        sr->se[sn->soff + j] = ej;
+        coef += sr->swr[sn->soff + j] * ej;
+        hp0 += coef * sr->sd0[sn->soff + j];
+        hp1 += coef * sr->sd1[sn->soff + j];
     }
     for (j = 0; j < sn->nh; j++) {
         const hm_real coef = sn->hw[j] * rhs->zh[n][j];
@@ -444,7 +445,8 @@ HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bo
 /* dz of the inequalities of stage n and the soft slack steps, from the (u, x) step of the stage.
  * Reads each entry of rhs before it writes the same entry of sol, so the two may be one vector. */
 HM_FUNC void ocp_qp_kkt_expand(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd,
-                               const hm_ocp_qp_ipm_vec *rhs, hm_ocp_qp_ipm_vec *sol, int n)
+                               const hm_ocp_qp_ipm_rows *sr, const hm_ocp_qp_ipm_vec *rhs, hm_ocp_qp_ipm_vec *sol,
+                               int n)
 {
     const hm_real *dux = sol->ux[n];
     const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
@@ -454,12 +456,12 @@ HM_FUNC void ocp_qp_kkt_expand(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ip
         for (l = 0; l < 2; l++) sol->zb[n][k][l] = bd->w[k][l][n] * (bd->sg[k][l][n] * dux[c] - rhs->zb[n][k][l]);
     }
     for (j = 0; j < sn->ns; j++) {
-        hm_real gd = -(sn->sd0[j] * dp0 + sn->sd1[j] * dp1);
-        const hm_real dsl = sn->se[j] + sn->swr[j] * sn->shi[j] * gd;
+        hm_real gd = -(sr->sd0[sn->soff + j] * dp0 + sr->sd1[sn->soff + j] * dp1);
+        const hm_real dsl = sr->se[sn->soff + j] + sr->swr[sn->soff + j] * sr->shi[sn->soff + j] * gd;
         sol->s[n][j] = dsl;
-        sol->zs[n][j] = sn->sws[j] * (-dsl - rhs->zs[n][j]);
+        sol->zs[n][j] = sr->sws[sn->soff + j] * (-dsl - rhs->zs[n][j]);
         gd -= dsl;
-        sol->zr[n][j] = sn->swr[j] * (gd - rhs->zr[n][j]);
+        sol->zr[n][j] = sr->swr[sn->soff + j] * (gd - rhs->zr[n][j]);
     }
     for (j = 0; j < sn->nh; j++) {
         const hm_real gd = -(sn->hd0[j] * dp0 + sn->hd1[j] * dp1);
@@ -474,7 +476,7 @@ HM_FUNC void ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const h
     for (n = HM_N; n >= 0; n--) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
         hm_real h[HM_QP_NUX];
-        ocp_qp_kkt_condense(sn, &ws->u.f.bd, rhs, n, h);
+        ocp_qp_kkt_condense(sn, &ws->u.f.bd, &ws->u.f.sr, rhs, n, h);
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) sn->ry[i] = rhs->y[n][i];
             ocp_qp_kkt_mv4(ws->u.f.st[n + 1].P, sn->ry, sn->Pry);
@@ -491,8 +493,8 @@ HM_FUNC void ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const h
             sol->ux[n + 1][HM_NU + i] = xn[i];
             sol->y[n][i] = dy[i];
         }
-        ocp_qp_kkt_expand(&ws->u.f.st[n], &ws->u.f.bd, rhs, sol, n);
+        ocp_qp_kkt_expand(&ws->u.f.st[n], &ws->u.f.bd, &ws->u.f.sr, rhs, sol, n);
     }
     for (i = 0; i < HM_NU; i++) sol->ux[HM_N][i] = HM_R(0.0);
-    ocp_qp_kkt_expand(&ws->u.f.st[HM_N], &ws->u.f.bd, rhs, sol, HM_N);
+    ocp_qp_kkt_expand(&ws->u.f.st[HM_N], &ws->u.f.bd, &ws->u.f.sr, rhs, sol, HM_N);
 }

@@ -33,6 +33,8 @@
 #define HM_QP_NNP ((HM_N + 8) / 8 * 8)
 /* rows per stage rounded up to even: rows are processed in pairs */
 #define HM_QP_NGP ((HM_NG + 1) / 2 * 2)
+/* the soft rows of all stages, each stage padded to even, the list to a multiple of 8 */
+#define HM_QP_NR (((HM_N + 1) * HM_QP_NGP + 7) / 8 * 8)
 
 /* The 2x2 input block and the (px, py) rows are written out for these sizes. */
 typedef char ocp_qp_kkt_sizes_fixed[(HM_NU == 2 && HM_NX == 4 && HM_NP == 2 && HM_NG <= 255) ? 1 : -1];

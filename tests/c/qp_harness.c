@@ -167,10 +167,11 @@ const char *qp_harness_status_message(int status)
 static void qp_harness_row_map(int n, int *kind, int *fam)
 {
     const hm_ocp_qp_ipm_stage *sn = &g_ws.u.f.st[n];
+    const hm_ocp_qp_ipm_rows *sr = &g_ws.u.f.sr;
     int i, js = 0, jh = 0, k = 0;
     for (i = 0; i < g_qp.ng[n] && n > 0; i++) {
         if (!ocp_qp_bound_present(g_qp.lg[n][i])) continue;
-        if (js < sn->ns && sn->srow[js] == i) {
+        if (js < sn->ns && sr->srow[sn->soff + js] == i) {
             kind[k] = 1;
             fam[k] = js++;
         } else {
@@ -217,6 +218,7 @@ int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
     int kind[HM_NG], fam[HM_NG];
     hm_ocp_qp_ipm_vec *v = &g_vec;
     hm_ocp_qp_ipm_bounds *bd = &g_ws.u.f.bd;
+    hm_ocp_qp_ipm_rows *sr = &g_ws.u.f.sr;
     if (ocp_qp_ipm_setup(&g_qp, &g_ws, &bad)) return HM_QP_INFEASIBLE;
     memset(v, 0, sizeof *v);
     for (n = 0; n <= HM_N; n++) {
@@ -237,7 +239,7 @@ int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
         qp_harness_row_map(n, kind, fam);
         for (k = 0; k < sn->ns + sn->nh; k++) {
             if (kind[k]) {
-                sn->swr[fam[k]] = w[pos];
+                sr->swr[sn->soff + fam[k]] = w[pos];
                 v->zr[n][fam[k]] = rhs[off_z + pos];
                 v->s[n][fam[k]] = rhs[off_s + n * HM_NG + k];
             } else {
@@ -247,7 +249,7 @@ int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
             pos++;
         }
         for (j = 0; j < sn->ns; j++) {
-            sn->sws[j] = w[pos];
+            sr->sws[sn->soff + j] = w[pos];
             v->zs[n][j] = rhs[off_z + pos];
             pos++;
         }
