@@ -28,6 +28,16 @@
 #endif
 #endif
 
+/* The 4x4 kernels of the Riccati recursion, called several times per stage: inline, so that their
+ * operands stay in registers (as calls, every result went through memory). */
+#ifndef HM_KERNEL
+#if defined(__GNUC__)
+#define HM_KERNEL static inline __attribute__((unused, always_inline))
+#else
+#define HM_KERNEL static inline
+#endif
+#endif
+
 #define HM_CONCAT_(a, b) a##b
 #define HM_CONCAT(a, b) HM_CONCAT_(a, b)
 

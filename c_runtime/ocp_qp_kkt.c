@@ -16,7 +16,7 @@
 #include "ocp_qp_kkt.h"
 
 /* F = P M for the symmetric 4x4 P (stored in full) and the 4 x ncol matrix M, in axpy form. */
-HM_FUNC void ocp_qp_kkt_mul4(const hm_real *restrict P, const hm_real *restrict M, hm_real *restrict F, int ncol)
+HM_KERNEL void ocp_qp_kkt_mul4(const hm_real *restrict P, const hm_real *restrict M, hm_real *restrict F, int ncol)
 {
     int i, j, k;
     for (j = 0; j < ncol; j++) {
@@ -30,13 +30,13 @@ HM_FUNC void ocp_qp_kkt_mul4(const hm_real *restrict P, const hm_real *restrict 
     }
 }
 
-HM_FUNC hm_real ocp_qp_kkt_dot4(const hm_real *restrict a, const hm_real *restrict b)
+HM_KERNEL hm_real ocp_qp_kkt_dot4(const hm_real *restrict a, const hm_real *restrict b)
 {
     return (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
 }
 
 /* y = P x for the full 4x4 P */
-HM_FUNC void ocp_qp_kkt_mv4(const hm_real *restrict P, const hm_real *restrict x, hm_real *restrict y)
+HM_KERNEL void ocp_qp_kkt_mv4(const hm_real *restrict P, const hm_real *restrict x, hm_real *restrict y)
 {
     int i, k;
     for (i = 0; i < HM_NX; i++) y[i] = P[i] * x[0];
