@@ -654,7 +654,7 @@ typedef struct {
 
 /* y = H_n x for the (scaled) cost Hessian [R S; S' Q] of stage n on (u, x); parts absent at stage 0
  * (x) and stage N (u) are zero in the stage block and in x. */
-HM_FUNC void ocp_qp_ipm_hess_mul(const hm_ocp_qp_ipm_stage *restrict sn, const hm_real *restrict x,
+HM_KERNEL void ocp_qp_ipm_hess_mul(const hm_ocp_qp_ipm_stage *restrict sn, const hm_real *restrict x,
                                  hm_real *restrict y)
 {
     const hm_real *restrict R = sn->R;

@@ -49,7 +49,7 @@ HM_KERNEL void ocp_qp_kkt_mv4(const hm_real *restrict P, const hm_real *restrict
 /* LDL' of the 2x2 input block [h00 h10; h10 h11] into sn->Ld (1 / d0, l10, 1 / d1); HM_QP_NUMERICAL
  * if a pivot is not safely positive: the QP is not strictly convex in u along the current active set
  * (`!(a > b)` also catches NaN). */
-HM_FUNC int ocp_qp_kkt_input_ldl(hm_ocp_qp_ipm_stage *restrict sn, hm_real h00, hm_real h10, hm_real h11)
+HM_KERNEL int ocp_qp_kkt_input_ldl(hm_ocp_qp_ipm_stage *restrict sn, hm_real h00, hm_real h10, hm_real h11)
 {
     hm_real id0, l10, d1;
     if (!(h00 > HM_R(0.0))) return HM_QP_NUMERICAL;
@@ -66,7 +66,7 @@ HM_FUNC int ocp_qp_kkt_input_ldl(hm_ocp_qp_ipm_stage *restrict sn, hm_real h00, 
 /* The closed-loop matrix F = A - B G of stage 0 < n < HM_N, G the feedback gain of the solves
  * (u = -G x + const): the substitutions carry p and x through F alone, one 4x4 product per stage
  * on their sequential chain instead of the gain's dot products followed by A and B. */
-HM_FUNC void ocp_qp_kkt_closed_loop(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn, int n)
+HM_KERNEL void ocp_qp_kkt_closed_loop(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn, int n)
 {
     const hm_real *restrict A = qp->A[n];
     const hm_real *restrict B = qp->B[n];
