@@ -196,8 +196,9 @@ typedef struct HM_NS(ocp_qp_ipm_bounds) {
  * count (ns2, the padding row absent), the list padded to a multiple of 8 with absent rows (live 0,
  * d = 0, at the neutral state s = t = z = zs = 1; HM_QP_NR of ocp_qp_kkt.h). Row r of stage n:
  * -(d' p + s) + t = -lg, s >= 0, cost zl s + Zl s^2 / 2 (times the cost scale). The passes of the
- * interior-point method run over the list eight rows at a time; p0, p1 (and dp0, dp1) copy the
- * position (and its step) of each row's stage. */
+ * interior-point method run over the list eight rows at a time, with d' p and d' dp of each row's
+ * stage in gp and gd. sdr, sdsb (from pass C to pass E) and se (the general solve's) are free in
+ * pass A, which keeps its per-row terms there until the stages have summed them (ocp_qp_ipm.c). */
 typedef struct HM_NS(ocp_qp_ipm_rows) {
     int nr;                           /* rows in the list, padding rows of the stages included */
     unsigned char srow[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];  /* QP row of the row within its stage */
@@ -214,10 +215,7 @@ typedef struct HM_NS(ocp_qp_ipm_rows) {
     HM_REAL srs[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];                  /* stationarity residual of s */
     HM_REAL sdr[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sdsb[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];         /* dt dz, ds dzs of the predictor */
     HM_REAL se[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];                   /* general solve: slack step at a zero position step */
-    HM_REAL p0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], p1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];            /* (px, py) of the row's stage: of the iterate, of the step */
-    HM_REAL dp0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], dp1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
-    /* pass A's per-row parts of the stage's (px, py) block, gradients and A' w; pass C's of hdl */
-    HM_REAL h00[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], h10[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], h11[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], g0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], g1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], m0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], m1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], a0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], a1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
+    HM_REAL gp[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], gd[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];            /* d' p at the iterate's position, d' dp at the step's */
 } HM_NS(ocp_qp_ipm_rows);
 
 /* A vector in the solver's layout (the Newton system's unknowns or right-hand side), used by the

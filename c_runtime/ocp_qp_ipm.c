@@ -354,7 +354,7 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         sr->slive[j] = HM_R(0.0);
         sr->ss[j] = sr->st[j] = sr->sz[j] = sr->szs[j] = HM_R(1.0);
         sr->sds[j] = sr->sdt[j] = sr->sdz[j] = sr->sdzs[j] = HM_R(0.0);
-        sr->p0[j] = sr->p1[j] = sr->dp0[j] = sr->dp1[j] = HM_R(0.0);
+        sr->gp[j] = sr->gd[j] = sr->sdr[j] = sr->sdsb[j] = sr->se[j] = HM_R(0.0);
     }
     return 0;
 }
@@ -479,9 +479,9 @@ HM_FUNC int ocp_qp_ipm_rows_blocks(const hm_ocp_qp_ipm_rows *sr)
     return (sr->nr + OCP_QP_IPM_LANES - 1) / OCP_QP_IPM_LANES * OCP_QP_IPM_LANES;
 }
 
-/* Pass A: the step, the weights, the eliminated slack, and per row its parts of the (px, py) block,
- * of the gradients ha and hmu and of A' w; lanes: t z, b w, q v, v P v, the primal and the slack's
- * dual residual. */
+/* Pass A: the step, the weights, the eliminated slack, and per row the factors of its parts of the
+ * stage's (px, py) block and gradients, we (in sdr), e (in sdsb) and cmu (in se); lanes: t z, b w,
+ * q v, v P v, the primal and the slack's dual residual. */
 HM_FUNC void ocp_qp_ipm_rows_a(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real alpha, hm_real wmax,
                                hm_real (*restrict lane)[OCP_QP_IPM_LANES])
 {
@@ -494,9 +494,8 @@ HM_FUNC void ocp_qp_ipm_rows_a(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
             const hm_real t = msk * (sr->st[q] + alpha * sr->sdt[q]) + (HM_R(1.0) - msk);
             const hm_real z = msk * (sr->sz[q] + alpha * sr->sdz[q]) + (HM_R(1.0) - msk);
             const hm_real zs = msk * (sr->szs[q] + alpha * sr->sdzs[q]) + (HM_R(1.0) - msk);
-            const hm_real d0 = sr->sd0[q], d1 = sr->sd1[q], lg = sr->slg[q], Zl = sr->sZl[q];
-            const hm_real gp = d0 * sr->p0[q] + d1 * sr->p1[q];
-            const hm_real rho = lg - gp - s;
+            const hm_real lg = sr->slg[q], Zl = sr->sZl[q];
+            const hm_real rho = lg - sr->gp[q] - s;
             const hm_real rs = Zl * s + sr->szl[q] - z - zs;
             const hm_real ia = HM_R(1.0) / (t * z), ib = HM_R(1.0) / (s * zs);
             const hm_real ti = z * ia, zi = t * ia, si = zs * ib, zsi = s * ib;
@@ -518,15 +517,9 @@ HM_FUNC void ocp_qp_ipm_rows_a(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
             sr->sws[q] = wsl;
             sr->shi[q] = hinv;
             sr->srs[q] = rs;
-            sr->h00[q] = we * d0 * d0;
-            sr->h10[q] = we * d0 * d1;
-            sr->h11[q] = we * d1 * d1;
-            sr->g0[q] = -d0 * e;
-            sr->g1[q] = -d1 * e;
-            sr->m0[q] = -d0 * cmu;
-            sr->m1[q] = -d1 * cmu;
-            sr->a0[q] = -d0 * z;
-            sr->a1[q] = -d1 * z;
+            sr->sdr[q] = we;
+            sr->sdsb[q] = e;
+            sr->se[q] = cmu;
             lane[0][l] += msk * (t * z + s * zs);
             lane[1][l] -= msk * lg * z;
             lane[2][l] += msk * sr->szl[q] * s;
@@ -537,8 +530,8 @@ HM_FUNC void ocp_qp_ipm_rows_a(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
     }
 }
 
-/* Pass C: the predictor's steps from the position steps dp, their products (kept in sdr, sdsb for
- * the corrector), per row its part of hdl on (px, py) in g0, g1; lanes: the step ratio,
+/* Pass C: the predictor's steps from the position steps (gd), their products (kept in sdr, sdsb for
+ * the corrector), per row the factor of its part of hdl on (px, py) in se; lanes: the step ratio,
  * t dz + z dt and dt dz. */
 HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real (*restrict lane)[OCP_QP_IPM_LANES])
 {
@@ -547,13 +540,12 @@ HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
         for (l = 0; l < OCP_QP_IPM_LANES; l++) {
             const int q = r0 + l;
             const hm_real msk = sr->slive[q];
-            const hm_real d0 = sr->sd0[q], d1 = sr->sd1[q];
             const hm_real s = sr->ss[q], t = sr->st[q], z = sr->sz[q], zs = sr->szs[q];
             const hm_real wr = sr->swr[q], wsl = sr->sws[q], hinv = sr->shi[q];
             const hm_real zi = sr->szi[q], zsi = sr->szsi[q];
             const hm_real hw = hinv * wr, we = hw * (sr->sZl[q] + wsl);
-            const hm_real gd = d0 * sr->dp0[q] + d1 * sr->dp1[q];
-            const hm_real rho = sr->slg[q] - (d0 * sr->p0[q] + d1 * sr->p1[q]) - s;
+            const hm_real gd = sr->gd[q];
+            const hm_real rho = sr->slg[q] - sr->gp[q] - s;
             const hm_real ds = hinv * (wr * rho - wsl * s - sr->srs[q]) - hw * gd;
             const hm_real dz = wr * (rho - gd - ds);
             const hm_real dzs = -wsl * (s + ds);
@@ -566,8 +558,7 @@ HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
             const hm_real coef = we * zi * dr - hw * wsl * zsi * dsb;
             sr->sdr[q] = dr;
             sr->sdsb[q] = dsb;
-            sr->g0[q] = d0 * coef;
-            sr->g1[q] = d1 * coef;
+            sr->se[q] = coef;
             lane[0][l] = OCP_QP_IPM_MAX(lane[0][l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sr->sti[q], -dz * zi),
                                                                   OCP_QP_IPM_MAX(-ds * sr->ssi[q], -dzs * zsi)));
             lane[1][l] += msk * (t * dz + z * dt + s * dzs + zs * ds);
@@ -585,14 +576,13 @@ HM_FUNC void ocp_qp_ipm_rows_e(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
     for (r0 = 0; r0 < nrp; r0 += OCP_QP_IPM_LANES) {
         for (l = 0; l < OCP_QP_IPM_LANES; l++) {
             const int q = r0 + l;
-            const hm_real d0 = sr->sd0[q], d1 = sr->sd1[q];
             const hm_real s = sr->ss[q], t = sr->st[q], z = sr->sz[q];
             const hm_real wr = sr->swr[q], wsl = sr->sws[q], hinv = sr->shi[q];
             const hm_real zi = sr->szi[q], zsi = sr->szsi[q];
             const hm_real cr = smu - kdel * sr->sdr[q], cs = smu - kdel * sr->sdsb[q];
             const hm_real hw = hinv * wr;
-            const hm_real gd = d0 * sr->dp0[q] + d1 * sr->dp1[q];
-            const hm_real rho0 = sr->slg[q] - (d0 * sr->p0[q] + d1 * sr->p1[q]) - s;
+            const hm_real gd = sr->gd[q];
+            const hm_real rho0 = sr->slg[q] - sr->gp[q] - s;
             const hm_real rho = rho0 + cr * zi;
             const hm_real rhos = cs * zsi - s;
             const hm_real ds = hinv * (wr * rho + wsl * rhos - sr->srs[q]) - hw * gd;
@@ -625,7 +615,7 @@ HM_FUNC void ocp_qp_ipm_rows_measures(const hm_ocp_qp_ipm_rows *restrict sr, int
             const int q = r0 + l;
             const hm_real msk = sr->slive[q];
             const hm_real t = sr->st[q], z = sr->sz[q], s = sr->ss[q], zs = sr->szs[q];
-            const hm_real av = t - (sr->sd0[q] * sr->p0[q] + sr->sd1[q] * sr->p1[q]) - s;
+            const hm_real av = t - sr->gp[q] - s;
             lane[0][l] = OCP_QP_IPM_MAX(lane[0][l], msk * OCP_QP_IPM_ABS(av));
             lane[1][l] = OCP_QP_IPM_MAX(lane[1][l], msk * t);
             lane[2][l] = OCP_QP_IPM_MAX(lane[2][l], msk * OCP_QP_IPM_MAX(OCP_QP_IPM_MIN(t, z), OCP_QP_IPM_MIN(s, zs)));
@@ -705,10 +695,8 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) sn->y[i] += alpha * sn->dy[i];
         }
-        for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
-            sr->p0[j] = sn->ux[HM_NU];
-            sr->p1[j] = sn->ux[HM_NU + 1];
-        }
+        for (j = sn->soff; j < sn->soff + sn->ns2; j++)
+            sr->gp[j] = sr->sd0[j] * sn->ux[HM_NU] + sr->sd1[j] * sn->ux[HM_NU + 1];
     }
 
     /* soft rows, all at once; their parts of the stages are summed in the stage loop */
@@ -836,15 +824,17 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
 
             /* soft rows (ocp_qp_ipm_rows_a, above): their parts summed into the stage */
             for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
-                h00[0] += sr->h00[j];
-                h10[0] += sr->h10[j];
-                h11[0] += sr->h11[j];
-                g0[0] += sr->g0[j];
-                g1[0] += sr->g1[j];
-                m0[0] += sr->m0[j];
-                m1[0] += sr->m1[j];
-                a0[0] += sr->a0[j];
-                a1[0] += sr->a1[j];
+                const hm_real d0 = sr->sd0[j], d1 = sr->sd1[j], we = sr->sdr[j];
+                const hm_real e = sr->sdsb[j], cmu = sr->se[j], z = sr->sz[j];
+                h00[0] += we * d0 * d0;
+                h10[0] += we * d0 * d1;
+                h11[0] += we * d1 * d1;
+                g0[0] -= d0 * e;
+                g1[0] -= d1 * e;
+                m0[0] -= d0 * cmu;
+                m1[0] -= d1 * cmu;
+                a0[0] -= d0 * z;
+                a1[0] -= d1 * z;
             }
             /* hard rows, in pairs */
             for (j = 0; j < sn->nh2; j += 2) {
@@ -1111,10 +1101,8 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         hm_real lane[3][OCP_QP_IPM_LANES];
         for (n = 1; n <= HM_N; n++) {
             const hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
-            for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
-                sr->dp0[j] = sn->dux[HM_NU];
-                sr->dp1[j] = sn->dux[HM_NU + 1];
-            }
+            for (j = sn->soff; j < sn->soff + sn->ns2; j++)
+                sr->gd[j] = sr->sd0[j] * sn->dux[HM_NU] + sr->sd1[j] * sn->dux[HM_NU + 1];
         }
         for (l = 0; l < OCP_QP_IPM_LANES; l++) lane[0][l] = lane[1][l] = lane[2][l] = HM_R(0.0);
         ocp_qp_ipm_rows_c(sr, ocp_qp_ipm_rows_blocks(sr), lane);
@@ -1148,8 +1136,8 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             hm_real *restrict hdl = sn->hdl;
             hm_real h0 = HM_R(0.0), h1 = HM_R(0.0);
             for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
-                h0 += sr->g0[j];
-                h1 += sr->g1[j];
+                h0 += sr->sd0[j] * sr->se[j];
+                h1 += sr->sd1[j] * sr->se[j];
             }
             hdl[HM_NU] += h0;
             hdl[HM_NU + 1] += h1;
@@ -1210,10 +1198,8 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
         hm_real lane[OCP_QP_IPM_LANES];
         for (n = 1; n <= HM_N; n++) {
             const hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
-            for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
-                sr->dp0[j] = sn->dux[HM_NU];
-                sr->dp1[j] = sn->dux[HM_NU + 1];
-            }
+            for (j = sn->soff; j < sn->soff + sn->ns2; j++)
+                sr->gd[j] = sr->sd0[j] * sn->dux[HM_NU] + sr->sd1[j] * sn->dux[HM_NU + 1];
         }
         for (l = 0; l < OCP_QP_IPM_LANES; l++) lane[l] = HM_R(0.0);
         ocp_qp_ipm_rows_e(sr, ocp_qp_ipm_rows_blocks(sr), smu, kdel, lane);
