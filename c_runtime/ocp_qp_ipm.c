@@ -145,6 +145,15 @@ HM_FUNC int ocp_qp_ipm_bounds_of(const hm_ocp_qp *qp, int n, int i, hm_real *lb,
     return 1;
 }
 
+/* The soft rows' passes take the list eight rows at a time (ocp_qp_ipm_rows). */
+#define OCP_QP_IPM_LANES 8
+
+/* rows of the list rounded up to whole blocks of lanes */
+HM_FUNC int ocp_qp_ipm_rows_blocks(const hm_ocp_qp_ipm_rows *sr)
+{
+    return (sr->nr + OCP_QP_IPM_LANES - 1) / OCP_QP_IPM_LANES * OCP_QP_IPM_LANES;
+}
+
 /* Builds the stage blocks of qp and the starting point. Returns HM_QP_INFEASIBLE if a lower bound
  * exceeds its upper bound; *bad = stage * HM_QP_NUX + component. */
 HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad)
@@ -346,8 +355,8 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         }
         for (j = 0; j < sn->nh2; j++) sn->hdt[j] = sn->hdz[j] = HM_R(0.0);
     }
-    /* the list's padding rows, absent like a stage's */
-    for (j = sr->nr; j < HM_QP_NR; j++) {
+    /* the list's padding rows up to the last block of the passes, absent like a stage's */
+    for (j = sr->nr; j < ocp_qp_ipm_rows_blocks(sr); j++) {
         sr->srow[j] = 0;
         sr->sd0[j] = sr->sd1[j] = sr->slg[j] = HM_R(0.0);
         sr->szl[j] = sr->sZl[j] = HM_R(1.0);
@@ -470,14 +479,6 @@ HM_FUNC void ocp_qp_ipm_bound_side_measures(const hm_real *restrict sg, const hm
  * Soft rows, eight rows of the list at a time (ocp_qp_ipm_rows): the same arithmetic for every row,
  * the stages' parts summed afterwards. Lanes keep the sums and maxima of the passes.
  * ---------------------------------------------------------------------------------------------- */
-
-#define OCP_QP_IPM_LANES 8
-
-/* rows of the list rounded up to whole blocks of lanes */
-HM_FUNC int ocp_qp_ipm_rows_blocks(const hm_ocp_qp_ipm_rows *sr)
-{
-    return (sr->nr + OCP_QP_IPM_LANES - 1) / OCP_QP_IPM_LANES * OCP_QP_IPM_LANES;
-}
 
 /* Pass A: the step, the weights, the eliminated slack, and per row the factors of its parts of the
  * stage's (px, py) block and gradients, we (in sdr), e (in sdsb) and cmu (in se); lanes: t z, b w,
