@@ -199,23 +199,23 @@ typedef struct HM_NS(ocp_qp_ipm_bounds) {
  * interior-point method run over the list eight rows at a time, with d' p and d' dp of each row's
  * stage in gp and gd. sdr, sdsb (from pass C to pass E) and se (the general solve's) are free in
  * pass A, which keeps its per-row terms there until the stages have summed them (ocp_qp_ipm.c). */
+/* one value per row of the list */
+typedef HM_REAL HM_NS(ocp_qp_ipm_row_vec)[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
 typedef struct HM_NS(ocp_qp_ipm_rows) {
     int nr;                           /* rows in the list, padding rows of the stages included */
-    unsigned char srow[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];  /* QP row of the row within its stage */
-    HM_REAL sd0[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sd1[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], slg[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
-    HM_REAL szl[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sZl[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], slive[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
-    HM_REAL ss[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], st[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];            /* slack s, row slack t */
-    HM_REAL sz[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], szs[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];           /* multipliers of the row, of s >= 0 */
-    HM_REAL sds[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sdt[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
-    HM_REAL sdz[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sdzs[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
-    HM_REAL swr[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sws[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];          /* weights z/t, zs/s */
-    HM_REAL shi[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];                  /* 1 / (Zl + wr + ws) */
-    HM_REAL sti[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], szi[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];          /* 1/t, 1/z */
-    HM_REAL ssi[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], szsi[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];         /* 1/s, 1/zs */
-    HM_REAL srs[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];                  /* stationarity residual of s */
-    HM_REAL sdr[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], sdsb[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];         /* dt dz, ds dzs of the predictor */
-    HM_REAL se[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];                   /* general solve: slack step at a zero position step */
-    HM_REAL gp[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8], gd[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];            /* d' p at the iterate's position, d' dp at the step's */
+    unsigned char srow[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];   /* QP row within its stage */
+    HM_NS(ocp_qp_ipm_row_vec) sd0, sd1, slg, szl, sZl, slive;
+    HM_NS(ocp_qp_ipm_row_vec) ss, st;        /* slack s, row slack t */
+    HM_NS(ocp_qp_ipm_row_vec) sz, szs;       /* multipliers of the row, of s >= 0 */
+    HM_NS(ocp_qp_ipm_row_vec) sds, sdt, sdz, sdzs;
+    HM_NS(ocp_qp_ipm_row_vec) swr, sws;      /* weights z/t, zs/s */
+    HM_NS(ocp_qp_ipm_row_vec) shi;           /* 1 / (Zl + wr + ws) */
+    HM_NS(ocp_qp_ipm_row_vec) sti, szi;      /* 1/t, 1/z */
+    HM_NS(ocp_qp_ipm_row_vec) ssi, szsi;     /* 1/s, 1/zs */
+    HM_NS(ocp_qp_ipm_row_vec) srs;           /* stationarity residual of s */
+    HM_NS(ocp_qp_ipm_row_vec) sdr, sdsb;     /* dt dz, ds dzs of the predictor */
+    HM_NS(ocp_qp_ipm_row_vec) se;            /* general solve: slack step at a zero position step */
+    HM_NS(ocp_qp_ipm_row_vec) gp, gd;        /* d' p at the iterate's position, d' dp at the step's */
 } HM_NS(ocp_qp_ipm_rows);
 
 /* A vector in the solver's layout (the Newton system's unknowns or right-hand side), used by the

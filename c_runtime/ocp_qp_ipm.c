@@ -27,7 +27,9 @@
 #include "ocp_qp_ipm.h"
 #include "ocp_qp_hsde.c"
 
-/* hm_types.h writes the padded stage count of ocp_qp_ipm_bounds out; it must be HM_QP_NNP */
+/* hm_types.h writes the sizes out: the padded stage count of ocp_qp_ipm_bounds must be HM_QP_NNP,
+ * the length of the row list of ocp_qp_ipm_rows HM_QP_NR */
+typedef char ocp_qp_ipm_nr_matches[sizeof(((hm_ocp_qp_ipm_rows *)0)->ss) == HM_QP_NR * sizeof(hm_real) ? 1 : -1];
 typedef char ocp_qp_ipm_nnp_matches[sizeof(((hm_ocp_qp_ipm_bounds *)0)->v[0]) == HM_QP_NNP * sizeof(hm_real) ? 1 : -1];
 
 /* Cap of the weights z / t, relative to the curvature of the cost. Near the solution the weights
@@ -154,6 +156,20 @@ HM_FUNC int ocp_qp_ipm_rows_blocks(const hm_ocp_qp_ipm_rows *sr)
     return (sr->nr + OCP_QP_IPM_LANES - 1) / OCP_QP_IPM_LANES * OCP_QP_IPM_LANES;
 }
 
+/* Row r of the list as an absent row (a stage's padding row, or the list's past its last stage): no
+ * coupling (d = 0), zero residuals at the state s = t = z = zs = 1, which pass A restores every
+ * iteration; its steps never shorten the step length. */
+HM_FUNC void ocp_qp_ipm_rows_absent(hm_ocp_qp_ipm_rows *sr, int r)
+{
+    sr->srow[r] = 0;
+    sr->sd0[r] = sr->sd1[r] = sr->slg[r] = HM_R(0.0);
+    sr->szl[r] = sr->sZl[r] = HM_R(1.0);
+    sr->slive[r] = HM_R(0.0);
+    sr->ss[r] = sr->st[r] = sr->sz[r] = sr->szs[r] = HM_R(1.0);
+    sr->sds[r] = sr->sdt[r] = sr->sdz[r] = sr->sdzs[r] = HM_R(0.0);
+    sr->gp[r] = sr->gd[r] = sr->sdr[r] = sr->sdsb[r] = sr->se[r] = HM_R(0.0);
+}
+
 /* Builds the stage blocks of qp and the starting point. Returns HM_QP_INFEASIBLE if a lower bound
  * exceeds its upper bound; *bad = stage * HM_QP_NUX + component. */
 HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad)
@@ -225,13 +241,14 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
                 if (!ocp_qp_bound_present(lg)) continue;
                 norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(lg));
                 if (qp->soft[n][i]) {
-                    sr->srow[sn->soff + ns] = (unsigned char)i;
-                    sr->sd0[sn->soff + ns] = qp->D[n][i][0];
-                    sr->sd1[sn->soff + ns] = qp->D[n][i][1];
-                    sr->slg[sn->soff + ns] = lg;
-                    sr->szl[sn->soff + ns] = qp->zl[n][i];
-                    sr->sZl[sn->soff + ns] = qp->Zl[n][i];
-                    sr->slive[sn->soff + ns] = HM_R(1.0);
+                    const int row = off + ns;
+                    sr->srow[row] = (unsigned char)i;
+                    sr->sd0[row] = qp->D[n][i][0];
+                    sr->sd1[row] = qp->D[n][i][1];
+                    sr->slg[row] = lg;
+                    sr->szl[row] = qp->zl[n][i];
+                    sr->sZl[row] = qp->Zl[n][i];
+                    sr->slive[row] = HM_R(1.0);
                     norm_q = OCP_QP_IPM_MAX(norm_q, hm_fabs(qp->zl[n][i]));
                     hscale = OCP_QP_IPM_MAX(hscale, hm_fabs(qp->Zl[n][i]));
                     ns++;
@@ -322,25 +339,18 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
             sn->dy[i] = HM_R(0.0);
         }
         for (j = 0; j < sn->ns; j++) {
-            const hm_real s = OCP_QP_IPM_MAX(HM_R(0.0), sr->slg[sn->soff + j]) + HM_R(1.0);
-            const hm_real t = OCP_QP_IPM_MAX(s - sr->slg[sn->soff + j], HM_R(1.0));
-            sr->szl[sn->soff + j] *= c;
-            sr->sZl[sn->soff + j] *= c;
-            sr->ss[sn->soff + j] = s;
-            sr->st[sn->soff + j] = t;
-            sr->sz[sn->soff + j] = HM_R(1.0) / t;
-            sr->szs[sn->soff + j] = HM_R(1.0) / s;
+            const int row = sn->soff + j;
+            const hm_real s = OCP_QP_IPM_MAX(HM_R(0.0), sr->slg[row]) + HM_R(1.0);
+            const hm_real t = OCP_QP_IPM_MAX(s - sr->slg[row], HM_R(1.0));
+            sr->szl[row] *= c;
+            sr->sZl[row] *= c;
+            sr->ss[row] = s;
+            sr->st[row] = t;
+            sr->sz[row] = HM_R(1.0) / t;
+            sr->szs[row] = HM_R(1.0) / s;
         }
-        if (sn->ns & 1) {
-            /* the padding row: no coupling (d = 0), zero residuals at the state (1, 1, 1, 1), which
-             * pass A restores every iteration; its steps never shorten the step length */
-            j = sn->ns;
-            sr->sd0[sn->soff + j] = sr->sd1[sn->soff + j] = sr->slg[sn->soff + j] = HM_R(0.0);
-            sr->szl[sn->soff + j] = sr->sZl[sn->soff + j] = HM_R(1.0);
-            sr->slive[sn->soff + j] = HM_R(0.0);
-            sr->ss[sn->soff + j] = sr->st[sn->soff + j] = sr->sz[sn->soff + j] = sr->szs[sn->soff + j] = HM_R(1.0);
-        }
-        for (j = 0; j < sn->ns2; j++) sr->sds[sn->soff + j] = sr->sdt[sn->soff + j] = sr->sdz[sn->soff + j] = sr->sdzs[sn->soff + j] = HM_R(0.0);
+        if (sn->ns & 1) ocp_qp_ipm_rows_absent(sr, sn->soff + sn->ns);   /* the stage's padding row */
+        for (j = sn->soff; j < sn->soff + sn->ns; j++) sr->sds[j] = sr->sdt[j] = sr->sdz[j] = sr->sdzs[j] = HM_R(0.0);
         for (j = 0; j < sn->nh; j++) {
             const hm_real t = OCP_QP_IPM_MAX(-sn->hlg[j], HM_R(1.0));
             sn->ht[j] = t;
@@ -355,16 +365,8 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         }
         for (j = 0; j < sn->nh2; j++) sn->hdt[j] = sn->hdz[j] = HM_R(0.0);
     }
-    /* the list's padding rows up to the last block of the passes, absent like a stage's */
-    for (j = sr->nr; j < ocp_qp_ipm_rows_blocks(sr); j++) {
-        sr->srow[j] = 0;
-        sr->sd0[j] = sr->sd1[j] = sr->slg[j] = HM_R(0.0);
-        sr->szl[j] = sr->sZl[j] = HM_R(1.0);
-        sr->slive[j] = HM_R(0.0);
-        sr->ss[j] = sr->st[j] = sr->sz[j] = sr->szs[j] = HM_R(1.0);
-        sr->sds[j] = sr->sdt[j] = sr->sdz[j] = sr->sdzs[j] = HM_R(0.0);
-        sr->gp[j] = sr->gd[j] = sr->sdr[j] = sr->sdsb[j] = sr->se[j] = HM_R(0.0);
-    }
+    /* the list's padding rows up to the last block of the passes */
+    for (j = sr->nr; j < ocp_qp_ipm_rows_blocks(sr); j++) ocp_qp_ipm_rows_absent(sr, j);
     return 0;
 }
 
@@ -1053,8 +1055,9 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         {
             hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
             const hm_real *restrict dux = sn->dux;
-            /* the rows' part of hdl, on (px, py) only; kept in scalars and stored entry by entry: a
-             * local array half written and then copied whole is a failed store forwarding per stage */
+            /* the hard rows' part of hdl, on (px, py) only (the soft rows' and the bound pairs' are
+             * added after the sweep); kept in scalars and stored entry by entry: a local array half
+             * written and then copied whole is a failed store forwarding per stage */
             hm_real hdl0 = HM_R(0.0), hdl1 = HM_R(0.0);
             for (k = 0; k < bd->nbp; k++) bd->dv[k][n] = dux[bd->bc[k]];   /* pass A has taken E's */
             if (n > 0) {
@@ -1071,11 +1074,11 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                         const hm_real gd = d0 * dp0 + d1 * dp1;
                         const hm_real rho = sn->hlg[q] - (d0 * p0 + d1 * p1);
                         const hm_real dz = w * (rho - gd);
-    #ifdef OCP_QP_IPM_DT_PRIMAL
+#ifdef OCP_QP_IPM_DT_PRIMAL
                         const hm_real dt = gd - (t + rho);
-    #else
+#else
                         const hm_real dt = -t - t * dz * zi;
-    #endif
+#endif
                         const hm_real del = dt * dz;
                         const hm_real coef = w * zi * del;
                         sn->hdel[q] = del;
@@ -1179,12 +1182,12 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
                         const hm_real gd = d0 * dp0 + d1 * dp1;
                         const hm_real rho0 = sn->hlg[q] - (d0 * p0 + d1 * p1);
                         const hm_real dz = w * (rho0 + cc * zi - gd);
-    #ifdef OCP_QP_IPM_DT_PRIMAL
+#ifdef OCP_QP_IPM_DT_PRIMAL
                         const hm_real dt = gd - (t + rho0);
                         (void)z;
-    #else
+#else
                         const hm_real dt = -(t * z - cc + t * dz) * zi;
-    #endif
+#endif
                         sn->hdz[q] = dz;
                         sn->hdt[q] = dt;
                         ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hti[q], -dz * zi));
@@ -1266,7 +1269,8 @@ HM_FUNC void ocp_qp_ipm_write_stage(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_
         }
     }
     for (j = 0; j < sn->ns; j++) {
-        const int i_row = sr->srow[sn->soff + j];
+        const int row = sn->soff + j;
+        const int i_row = sr->srow[row];
         sol->s[n][i_row] = sp * s[j];
         sol->lam_lg[n][i_row] = sc * zr[j];
         sol->lam_ls[n][i_row] = sc * zs[j];
@@ -1316,8 +1320,8 @@ HM_FUNC void ocp_qp_ipm_write_sol_vec(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_w
         if (n > 0) {
             for (i = 0; i < HM_NX; i++) sol->x[n][i] = v->ux[n][HM_NU + i];
         }
-        ocp_qp_ipm_write_stage(&ws->u.f.st[n], &ws->u.f.bd, &ws->u.f.sr, n, sol, (const hm_real (*)[2])v->zb[n], v->s[n], v->zr[n],
-                               v->zs[n], v->zh[n], sc, HM_R(1.0));
+        ocp_qp_ipm_write_stage(&ws->u.f.st[n], &ws->u.f.bd, &ws->u.f.sr, n, sol, (const hm_real (*)[2])v->zb[n],
+                               v->s[n], v->zr[n], v->zs[n], v->zh[n], sc, HM_R(1.0));
     }
 }
 
@@ -1355,10 +1359,11 @@ HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, c
             }
         }
         for (j = 0; j < sn->ns; j++) {
+            const int row = sn->soff + j;
             const hm_real as = OCP_QP_IPM_ABS(w->zr[n][j] + w->zs[n][j]);
-            atw[HM_NU] -= sr->sd0[sn->soff + j] * w->zr[n][j];
-            atw[HM_NU + 1] -= sr->sd1[sn->soff + j] * w->zr[n][j];
-            bw -= sr->slg[sn->soff + j] * w->zr[n][j];
+            atw[HM_NU] -= sr->sd0[row] * w->zr[n][j];
+            atw[HM_NU + 1] -= sr->sd1[row] * w->zr[n][j];
+            bw -= sr->slg[row] * w->zr[n][j];
             atw_n = OCP_QP_IPM_MAX(atw_n, as);
         }
         for (j = 0; j < sn->nh; j++) {
@@ -1409,10 +1414,11 @@ HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws
             for (l = 0; l < 2; l++) ad = OCP_QP_IPM_MAX(ad, bd->sg[k][l][n] * d[bd->bc[k]]);
         }
         for (j = 0; j < sn->ns; j++) {
-            const hm_real gd = sr->sd0[sn->soff + j] * d[HM_NU] + sr->sd1[sn->soff + j] * d[HM_NU + 1];
-            qd += sr->szl[sn->soff + j] * sr->sds[sn->soff + j];
-            pd = OCP_QP_IPM_MAX(pd, OCP_QP_IPM_ABS(sr->sZl[sn->soff + j] * sr->sds[sn->soff + j]));
-            ad = OCP_QP_IPM_MAX(ad, OCP_QP_IPM_MAX(-(gd + sr->sds[sn->soff + j]), -sr->sds[sn->soff + j]));
+            const int row = sn->soff + j;
+            const hm_real gd = sr->sd0[row] * d[HM_NU] + sr->sd1[row] * d[HM_NU + 1];
+            qd += sr->szl[row] * sr->sds[row];
+            pd = OCP_QP_IPM_MAX(pd, OCP_QP_IPM_ABS(sr->sZl[row] * sr->sds[row]));
+            ad = OCP_QP_IPM_MAX(ad, OCP_QP_IPM_MAX(-(gd + sr->sds[row]), -sr->sds[row]));
         }
         for (j = 0; j < sn->nh; j++) ad = OCP_QP_IPM_MAX(ad, -(sn->hd0[j] * d[HM_NU] + sn->hd1[j] * d[HM_NU + 1]));
     }
@@ -1438,9 +1444,10 @@ HM_FUNC void ocp_qp_ipm_ray_from_step(hm_ocp_qp_ipm_ws *ws)
             for (l = 0; l < 2; l++) v->zb[n][k][l] = OCP_QP_IPM_MAX(bd->dz[k][l][n], HM_R(0.0));
         }
         for (j = 0; j < sn->ns; j++) {
+            const int row = sn->soff + j;
             v->s[n][j] = HM_R(0.0);
-            v->zr[n][j] = OCP_QP_IPM_MAX(sr->sdz[sn->soff + j], HM_R(0.0));
-            v->zs[n][j] = OCP_QP_IPM_MAX(sr->sdzs[sn->soff + j], HM_R(0.0));
+            v->zr[n][j] = OCP_QP_IPM_MAX(sr->sdz[row], HM_R(0.0));
+            v->zs[n][j] = OCP_QP_IPM_MAX(sr->sdzs[row], HM_R(0.0));
         }
         for (j = 0; j < sn->nh; j++) v->zh[n][j] = OCP_QP_IPM_MAX(sn->hdz[j], HM_R(0.0));
     }
@@ -1498,13 +1505,14 @@ HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm
             }
         }
         for (j = 0; j < sn->ns; j++) {
-            const hm_real gp = sr->sd0[sn->soff + j] * ux[HM_NU] + sr->sd1[sn->soff + j] * ux[HM_NU + 1];
-            const hm_real tr = sr->swr[sn->soff + j] < wmax ? -d->zr[n][j] / sr->swr[sn->soff + j] : HM_R(0.0);
-            const hm_real ts = sr->sws[sn->soff + j] < wmax ? -d->zs[n][j] / sr->sws[sn->soff + j] : HM_R(0.0);
-            r[HM_NU] -= sr->sd0[sn->soff + j] * d->zr[n][j];
-            r[HM_NU + 1] -= sr->sd1[sn->soff + j] * d->zr[n][j];
-            e->s[n][j] = -(sr->sZl[sn->soff + j] * d->s[n][j] + sr->szl[sn->soff + j] - d->zr[n][j] - d->zs[n][j]);
-            e->zr[n][j] = -(tr - gp - d->s[n][j] + sr->slg[sn->soff + j]);
+            const int row = sn->soff + j;
+            const hm_real gp = sr->sd0[row] * ux[HM_NU] + sr->sd1[row] * ux[HM_NU + 1];
+            const hm_real tr = sr->swr[row] < wmax ? -d->zr[n][j] / sr->swr[row] : HM_R(0.0);
+            const hm_real ts = sr->sws[row] < wmax ? -d->zs[n][j] / sr->sws[row] : HM_R(0.0);
+            r[HM_NU] -= sr->sd0[row] * d->zr[n][j];
+            r[HM_NU + 1] -= sr->sd1[row] * d->zr[n][j];
+            e->s[n][j] = -(sr->sZl[row] * d->s[n][j] + sr->szl[row] - d->zr[n][j] - d->zs[n][j]);
+            e->zr[n][j] = -(tr - gp - d->s[n][j] + sr->slg[row]);
             e->zs[n][j] = -(ts - d->s[n][j]);
         }
         for (j = 0; j < sn->nh; j++) {
@@ -1605,8 +1613,9 @@ HM_FUNC int ocp_qp_ipm_undecided(const hm_ocp_qp_ipm_ws *ws, hm_real alpha)
             }
         }
         for (j = 0; j < sn->ns; j++) {
-            if (ocp_qp_ipm_undecided_pair(sr->st[sn->soff + j], sr->sz[sn->soff + j], sr->sdt[sn->soff + j], sr->sdz[sn->soff + j], alpha)
-                || ocp_qp_ipm_undecided_pair(sr->ss[sn->soff + j], sr->szs[sn->soff + j], sr->sds[sn->soff + j], sr->sdzs[sn->soff + j], alpha))
+            const int row = sn->soff + j;
+            if (ocp_qp_ipm_undecided_pair(sr->st[row], sr->sz[row], sr->sdt[row], sr->sdz[row], alpha)
+                || ocp_qp_ipm_undecided_pair(sr->ss[row], sr->szs[row], sr->sds[row], sr->sdzs[row], alpha))
                 return 1;
         }
         for (j = 0; j < sn->nh; j++) {
@@ -1653,8 +1662,11 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
             }
         }
         for (j = 0; j < sn->ns; j++) {
-            sr->swr[sn->soff + j] = ocp_qp_ipm_polish_active(sr->st[sn->soff + j], sr->sz[sn->soff + j], sr->sdt[sn->soff + j], sr->sdz[sn->soff + j], alpha) ? wmax : w_drop;
-            sr->sws[sn->soff + j] = ocp_qp_ipm_polish_active(sr->ss[sn->soff + j], sr->szs[sn->soff + j], sr->sds[sn->soff + j], sr->sdzs[sn->soff + j], alpha) ? wmax : w_drop;
+            const int row = sn->soff + j;
+            const int row_on = ocp_qp_ipm_polish_active(sr->st[row], sr->sz[row], sr->sdt[row], sr->sdz[row], alpha);
+            const int slack_on = ocp_qp_ipm_polish_active(sr->ss[row], sr->szs[row], sr->sds[row], sr->sdzs[row], alpha);
+            sr->swr[row] = row_on ? wmax : w_drop;
+            sr->sws[row] = slack_on ? wmax : w_drop;
         }
         for (j = 0; j < sn->nh; j++)
             sn->hw[j] = ocp_qp_ipm_polish_active(sn->ht[j], sn->hz[j], sn->hdt[j], sn->hdz[j], alpha) ? wmax : w_drop;
@@ -1679,8 +1691,9 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
                 e->zb[n][k][1] = bd->b[k][1][n];
             }
             for (j = 0; j < sn->ns; j++) {
-                e->s[n][j] = -sr->szl[sn->soff + j];
-                e->zr[n][j] = -sr->slg[sn->soff + j];
+                const int row = sn->soff + j;
+                e->s[n][j] = -sr->szl[row];
+                e->zr[n][j] = -sr->slg[row];
                 e->zs[n][j] = HM_R(0.0);
             }
             for (j = 0; j < sn->nh; j++) e->zh[n][j] = -sn->hlg[j];
@@ -1703,9 +1716,10 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
                 }
             }
             for (j = 0; j < sn->ns; j++) {
-                const hm_real g = sr->sd0[sn->soff + j] * v[HM_NU] + sr->sd1[sn->soff + j] * v[HM_NU + 1] + d->s[n][j] - sr->slg[sn->soff + j];
-                sr->swr[sn->soff + j] = ocp_qp_ipm_polish_weight(sr->swr[sn->soff + j], &d->zr[n][j], g, wmax, w_drop, &changed);
-                sr->sws[sn->soff + j] = ocp_qp_ipm_polish_weight(sr->sws[sn->soff + j], &d->zs[n][j], d->s[n][j], wmax, w_drop, &changed);
+                const int row = sn->soff + j;
+                const hm_real g = sr->sd0[row] * v[HM_NU] + sr->sd1[row] * v[HM_NU + 1] + d->s[n][j] - sr->slg[row];
+                sr->swr[row] = ocp_qp_ipm_polish_weight(sr->swr[row], &d->zr[n][j], g, wmax, w_drop, &changed);
+                sr->sws[row] = ocp_qp_ipm_polish_weight(sr->sws[row], &d->zs[n][j], d->s[n][j], wmax, w_drop, &changed);
             }
             for (j = 0; j < sn->nh; j++) {
                 const hm_real g = sn->hd0[j] * v[HM_NU] + sn->hd1[j] * v[HM_NU + 1] - sn->hlg[j];

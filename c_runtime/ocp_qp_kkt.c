@@ -379,16 +379,17 @@ HM_FUNC void ocp_qp_kkt_condense_weights(hm_ocp_qp_ipm_ws *ws)
                          + bd->sg[k][1][n] * bd->sg[k][1][n] * bd->w[k][1][n];
         }
         for (j = 0; j < sn->ns; j++) {
+            const int row = sn->soff + j;
             /* a soft row with weight wr, slack-bound weight ws and slack Hessian Zl acts like a hard
              * row of weight wr (Zl + ws) / (Zl + wr + ws) (the two in series; as a product, not as
              * wr - wr^2 / (...), which cancels when wr is large) */
-            const hm_real hinv = HM_R(1.0) / (sr->sZl[sn->soff + j] + sr->swr[sn->soff + j] + sr->sws[sn->soff + j]);
-            const hm_real we = sr->swr[sn->soff + j] * (sr->sZl[sn->soff + j] + sr->sws[sn->soff + j]) * hinv;
-            const hm_real wd0 = we * sr->sd0[sn->soff + j];
-            sr->shi[sn->soff + j] = hinv;
-            h00 += wd0 * sr->sd0[sn->soff + j];
-            h10 += wd0 * sr->sd1[sn->soff + j];
-            h11 += we * sr->sd1[sn->soff + j] * sr->sd1[sn->soff + j];
+            const hm_real hinv = HM_R(1.0) / (sr->sZl[row] + sr->swr[row] + sr->sws[row]);
+            const hm_real we = sr->swr[row] * (sr->sZl[row] + sr->sws[row]) * hinv;
+            const hm_real wd0 = we * sr->sd0[row];
+            sr->shi[row] = hinv;
+            h00 += wd0 * sr->sd0[row];
+            h10 += wd0 * sr->sd1[row];
+            h11 += we * sr->sd1[row] * sr->sd1[row];
         }
         for (j = 0; j < sn->nh; j++) {
             const hm_real wd0 = sn->hw[j] * sn->hd0[j];
@@ -426,12 +427,13 @@ HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bo
                 + bd->sg[k][1][n] * bd->w[k][1][n] * rhs->zb[n][k][1];
     }
     for (j = 0; j < sn->ns; j++) {
-        hm_real coef = sr->swr[sn->soff + j] * rhs->zr[n][j];
-        const hm_real ej = (rhs->s[n][j] - coef - sr->sws[sn->soff + j] * rhs->zs[n][j]) * sr->shi[sn->soff + j];
-        sr->se[sn->soff + j] = ej;
-        coef += sr->swr[sn->soff + j] * ej;
-        hp0 += coef * sr->sd0[sn->soff + j];
-        hp1 += coef * sr->sd1[sn->soff + j];
+        const int row = sn->soff + j;
+        hm_real coef = sr->swr[row] * rhs->zr[n][j];
+        const hm_real ej = (rhs->s[n][j] - coef - sr->sws[row] * rhs->zs[n][j]) * sr->shi[row];
+        sr->se[row] = ej;
+        coef += sr->swr[row] * ej;
+        hp0 += coef * sr->sd0[row];
+        hp1 += coef * sr->sd1[row];
     }
     for (j = 0; j < sn->nh; j++) {
         const hm_real coef = sn->hw[j] * rhs->zh[n][j];
@@ -456,12 +458,13 @@ HM_FUNC void ocp_qp_kkt_expand(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ip
         for (l = 0; l < 2; l++) sol->zb[n][k][l] = bd->w[k][l][n] * (bd->sg[k][l][n] * dux[c] - rhs->zb[n][k][l]);
     }
     for (j = 0; j < sn->ns; j++) {
-        hm_real gd = -(sr->sd0[sn->soff + j] * dp0 + sr->sd1[sn->soff + j] * dp1);
-        const hm_real dsl = sr->se[sn->soff + j] + sr->swr[sn->soff + j] * sr->shi[sn->soff + j] * gd;
+        const int row = sn->soff + j;
+        hm_real gd = -(sr->sd0[row] * dp0 + sr->sd1[row] * dp1);
+        const hm_real dsl = sr->se[row] + sr->swr[row] * sr->shi[row] * gd;
         sol->s[n][j] = dsl;
-        sol->zs[n][j] = sr->sws[sn->soff + j] * (-dsl - rhs->zs[n][j]);
+        sol->zs[n][j] = sr->sws[row] * (-dsl - rhs->zs[n][j]);
         gd -= dsl;
-        sol->zr[n][j] = sr->swr[sn->soff + j] * (gd - rhs->zr[n][j]);
+        sol->zr[n][j] = sr->swr[row] * (gd - rhs->zr[n][j]);
     }
     for (j = 0; j < sn->nh; j++) {
         const hm_real gd = -(sn->hd0[j] * dp0 + sn->hd1[j] * dp1);
