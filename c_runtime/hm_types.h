@@ -110,6 +110,9 @@ typedef struct HM_NS(ocp_qp_ipm_arg) {
                                 QP's are left out (the polish still measures them) */
     int detect_unbounded;    /* 1: test stalling steps for a ray of unbounded descent (ocp_qp_ipm.h); 0 for
                                 QPs bounded by construction */
+    int recurrence;          /* 1: the residuals of the equations follow the steps by their recurrence between
+                                exact evaluations (ocp_qp_ipm.c); 0: exact in every iteration, whose steps
+                                then leave the residuals far below tol (a reference solve) */
     int (*should_stop)(void *ctx);   /* polled once per iteration; nonzero ends with HM_QP_TIMEOUT */
     void *stop_ctx;
 } HM_NS(ocp_qp_ipm_arg);
@@ -151,6 +154,9 @@ typedef struct HM_NS(ocp_qp_ipm_stage) {
     /* iterate and step of the stage; ry: right-hand side of the dynamics n -> n + 1 in the Newton
      * system (minus their residual) */
     HM_REAL ux[HM_NU + HM_NX], y[HM_NX], dux[HM_NU + HM_NX], dy[HM_NX], ry[HM_NX];
+    /* the stationarity residual P v + q + A' w of (u, x); it and ry follow the iterate by the
+     * recurrence r <- (1 - alpha) r between exact evaluations (ocp_qp_ipm.c) */
+    HM_REAL rv[HM_NU + HM_NX];
     /* Newton system: the families condensed into the stage (diagonal, (px, py) block), gradients of
      * the predictor and the two parts of the corrector's change, and the Riccati factor */
     HM_REAL Hd[HM_NU + HM_NX], Hpp[3];

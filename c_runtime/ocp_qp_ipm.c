@@ -50,6 +50,10 @@ typedef char ocp_qp_ipm_nnp_matches[sizeof(((hm_ocp_qp_ipm_bounds *)0)->v[0]) ==
  * passing on the stage vectors' normalisation alone (ocp_qp_ipm_solve). */
 #define OCP_QP_IPM_MEASURE_NEAR HM_R(1e3)
 
+/* Between stage measures the dual residual and the gap are compared with tol times this factor
+ * (their normalisations are the last stage measures', ocp_qp_ipm_solve). */
+#define OCP_QP_IPM_STAGE_NEAR HM_R(10.0)
+
 /* Iterations over which a feasible iterate's mu must fall by 4 (ocp_qp_ipm_solve). */
 #define OCP_QP_IPM_STALL_ITERS 4
 
@@ -103,6 +107,7 @@ HM_FUNC void ocp_qp_ipm_arg_set_default(hm_ocp_qp_ipm_arg *arg)
     arg->polish = 0;
     arg->residuals = 1;
     arg->detect_unbounded = 1;
+    arg->recurrence = 1;
     arg->should_stop = NULL;
     arg->stop_ctx = NULL;
 }
@@ -337,7 +342,9 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         for (i = 0; i < HM_NX; i++) {
             sn->y[i] = HM_R(0.0);
             sn->dy[i] = HM_R(0.0);
+            sn->ry[i] = HM_R(0.0);
         }
+        for (i = 0; i < HM_QP_NUX; i++) sn->rv[i] = HM_R(0.0);   /* set by the first stage measures */
         for (j = 0; j < sn->ns; j++) {
             const int row = sn->soff + j;
             const hm_real s = OCP_QP_IPM_MAX(HM_R(0.0), sr->slg[row]) + HM_R(1.0);
@@ -632,14 +639,26 @@ HM_FUNC void ocp_qp_ipm_rows_measures(const hm_ocp_qp_ipm_rows *restrict sr, int
  * Pass A: step, residuals, weights, condensation
  * ---------------------------------------------------------------------------------------------- */
 
-/* Scalars of one residual evaluation. Pass A computes the sums, the residual norms and the norms
- * of the stage vectors; the norms over the inequalities (av_ineq .. pv_s) only enter the
- * termination tests' normalisation, the natural residual and the certificate test, and are
- * computed by ocp_qp_ipm_row_measures only when one of those tests can pass (ocp_qp_ipm_solve). */
+/* Scalars of one residual evaluation. Pass A computes the inequalities' parts exactly and takes the
+ * residuals of the dynamics (ry) and of the stationarity of (u, x) (rv) by their recurrence: a
+ * Newton step solves those linear equations, so a step of length alpha leaves (1 - alpha) of them.
+ * The recurrence saves the stage products (P v, A' w, A_E v) in most iterations; they are evaluated
+ * exactly (ocp_qp_ipm_stage_measures: the residuals afresh, the norms of the stage vectors, the
+ * cost) in the first iteration and whenever the termination tests could pass, so no test passes on
+ * recurred values and rounding drift cannot accumulate into the solution (ocp_qp_ipm_solve). The
+ * norms over the inequalities (av_ineq .. pv_s) only enter the termination tests' normalisation,
+ * the natural residual and the certificate test, and are computed by ocp_qp_ipm_row_measures only
+ * when one of those tests can pass. */
 typedef struct {
-    hm_real qv, bw, vPv, tz;          /* q' v, b' w, v' P v, t' z */
-    hm_real atw, pv, av_eq;           /* inf-norms over (u, x) of A' w and P v; of A_E v */
+    hm_real qv, bw, vPv, tz;          /* q' v, b' w, v' P v, t' z (q' v, v' P v: after stage measures) */
+    hm_real atw, pv, av_eq;           /* inf-norms over (u, x) of A' w and P v; of A_E v (the same) */
     hm_real rd, rp;                   /* inf-norms of the dual and primal residuals */
+    hm_real rd_eq, rp_eq;             /* their parts of the stationarity of (u, x), of the dynamics */
+    hm_real rd_in, rp_in;             /* and of the soft slacks, of the inequalities */
+    hm_real qv_in, vPv_in;            /* the soft slacks' parts of q' v and v' P v */
+    hm_real vz;                       /* 0 * sum of v: NaN if v holds a NaN or an infinity */
+    int exact;                        /* the stage measures are of this iterate */
+    int measured;                     /* so are the inequality measures */
     hm_real av_ineq, nt;              /* inf-norms of A_I v + t and of t */
     hm_real ncr;                      /* max over inequalities of min(t, z) */
     hm_real atw_s, pv_s;              /* inf-norms over the soft slacks of A' w and P v */
@@ -672,29 +691,31 @@ HM_KERNEL void ocp_qp_ipm_hess_mul(const hm_ocp_qp_ipm_stage *restrict sn, const
     for (i = 0; i < HM_NX; i++) y[HM_NU + i] = yx[i];
 }
 
-HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha,
-                               ocp_qp_ipm_sums *restrict sm)
+HM_FUNC void ocp_qp_ipm_pass_a(hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha, ocp_qp_ipm_sums *restrict sm)
 {
     const hm_real wmax = ws->w_max;
-    hm_real qv = HM_R(0.0), bw = HM_R(0.0), vPv = HM_R(0.0), tz = HM_R(0.0);
-    hm_real atw_n = HM_R(0.0), pv_n = HM_R(0.0), aveq_n = HM_R(0.0);
-    hm_real rd = HM_R(0.0), rp = HM_R(0.0);
+    const hm_real keep = HM_R(1.0) - alpha;
+    hm_real qv = HM_R(0.0), bw = HM_R(0.0), vPv = HM_R(0.0), tz = HM_R(0.0), vz = HM_R(0.0);
+    hm_real rd = HM_R(0.0), rp = HM_R(0.0), rd_eq = HM_R(0.0), rp_eq = HM_R(0.0);
     /* The maxima are taken entry by entry across the stages and reduced at the end: the same
      * numbers (max is exact in any order), in vector lanes instead of one scalar chain. */
-    hm_real rd_v[HM_QP_NUX], pv_v[HM_QP_NUX], atw_v[HM_QP_NUX], eq_v[HM_NX], rpe_v[HM_NX];
+    hm_real rd_v[HM_QP_NUX], rpe_v[HM_NX];
     hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
     int n, i, j, k, l;
 
-    for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = pv_v[i] = atw_v[i] = HM_R(0.0);
-    for (i = 0; i < HM_NX; i++) eq_v[i] = rpe_v[i] = HM_R(0.0);
+    for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = HM_R(0.0);
+    for (i = 0; i < HM_NX; i++) rpe_v[i] = HM_R(0.0);
 
     /* the step, for all stages before the stage loop reads them: updated inside it, a stage's
      * (u, x) was stored in parts and read back across those parts while the stores were still in
      * flight (a failed store forwarding per stage) */
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
-        for (i = 0; i < HM_QP_NUX; i++) sn->ux[i] += alpha * sn->dux[i];
+        for (i = 0; i < HM_QP_NUX; i++) {
+            sn->ux[i] += alpha * sn->dux[i];
+            vz += HM_R(0.0) * sn->ux[i];
+        }
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) sn->y[i] += alpha * sn->dy[i];
         }
@@ -748,57 +769,17 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
 
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
-        hm_real *restrict ux = sn->ux;
-        hm_real Pux[HM_QP_NUX], atw[HM_QP_NUX], hf[HM_QP_NUX], hmu[HM_QP_NUX], Hd[HM_QP_NUX];
+        hm_real hf[HM_QP_NUX], hmu[HM_QP_NUX], Hd[HM_QP_NUX];
 
-        /* dynamics n - 1 -> n: x_n - A x_{n-1} - B u_{n-1} = b_{n-1} */
-        if (n > 0) {
-            hm_ocp_qp_ipm_stage *restrict sp = &ws->u.f.st[n - 1];
-            const hm_real *restrict A = qp->A[n - 1];
-            const hm_real *restrict B = qp->B[n - 1];
-            const hm_real *restrict up = sp->ux;
-            hm_real e[HM_NX];
-            for (i = 0; i < HM_NX; i++) e[i] = ux[HM_NU + i] - B[i] * up[0] - B[i + HM_NX] * up[1];
-            /* all of A, also where its first columns are e_0, e_1 (sp->a_id): the products with
-             * 1 and 0 are exact, and a uniform loop keeps e in registers (the special case
-             * stored half of e and reloaded it whole, a failed store forwarding per stage) */
-            if (n > 1) {
-                for (k = 0; k < HM_NX; k++) {
-                    const hm_real xk = up[HM_NU + k];
-                    for (i = 0; i < HM_NX; i++) e[i] -= A[i + k * HM_NX] * xk;
-                }
-            }
-            for (i = 0; i < HM_NX; i++) {
-                const hm_real ri = e[i] - sp->beq[i];
-                sp->ry[i] = -ri;
-                eq_v[i] = OCP_QP_IPM_MAX(eq_v[i], OCP_QP_IPM_ABS(e[i]));
-                rpe_v[i] = OCP_QP_IPM_MAX(rpe_v[i], OCP_QP_IPM_ABS(ri));
-            }
-        }
-
-        /* A_E' y */
+        /* dynamics n -> n + 1, by the recurrence */
         if (n < HM_N) {
-            const hm_real *restrict B = qp->B[n];
             const hm_real *restrict y = sn->y;
-            atw[0] = -(B[0] * y[0] + B[1] * y[1] + B[2] * y[2] + B[3] * y[3]);
-            atw[1] = -(B[4] * y[0] + B[5] * y[1] + B[6] * y[2] + B[7] * y[3]);
-            bw += (sn->beq[0] * y[0] + sn->beq[1] * y[1]) + (sn->beq[2] * y[2] + sn->beq[3] * y[3]);
-        } else {
-            atw[0] = atw[1] = HM_R(0.0);
-        }
-        if (n > 0) {
-            const hm_real *restrict ym = ws->u.f.st[n - 1].y;
-            for (i = 0; i < HM_NX; i++) atw[HM_NU + i] = ym[i];
-            if (n < HM_N) {
-                const hm_real *restrict A = qp->A[n];
-                const hm_real *restrict y = sn->y;
-                for (i = 0; i < HM_NX; i++) {
-                    const hm_real *restrict a = &A[i * HM_NX];
-                    atw[HM_NU + i] -= (a[0] * y[0] + a[1] * y[1]) + (a[2] * y[2] + a[3] * y[3]);
-                }
+            for (i = 0; i < HM_NX; i++) {
+                const hm_real r = keep * sn->ry[i];
+                sn->ry[i] = r;
+                rpe_v[i] = OCP_QP_IPM_MAX(rpe_v[i], OCP_QP_IPM_ABS(r));
             }
-        } else {
-            for (i = 0; i < HM_NX; i++) atw[HM_NU + i] = HM_R(0.0);
+            bw += (sn->beq[0] * y[0] + sn->beq[1] * y[1]) + (sn->beq[2] * y[2] + sn->beq[3] * y[3]);
         }
         for (i = 0; i < HM_QP_NUX; i++) {
             hf[i] = HM_R(0.0);
@@ -809,26 +790,23 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
         /* bound pairs (above) */
         for (k = 0; k < bd->nbp; k++) {
             const int c = bd->bc[k];
-            atw[c] += bd->atw[k][n];
             Hd[c] += bd->Hd[k][n];
             hf[c] += bd->hf[k][n];
             hmu[c] += bd->hmu[k][n];
         }
 
         if (n > 0) {
-            const hm_real p0 = ux[HM_NU], p1 = ux[HM_NU + 1];
+            const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
             hm_real h00[2] = {HM_R(0.0), HM_R(0.0)}, h10[2] = {HM_R(0.0), HM_R(0.0)}, h11[2] = {HM_R(0.0), HM_R(0.0)};
             hm_real g0[2] = {HM_R(0.0), HM_R(0.0)}, g1[2] = {HM_R(0.0), HM_R(0.0)};
             hm_real m0[2] = {HM_R(0.0), HM_R(0.0)}, m1[2] = {HM_R(0.0), HM_R(0.0)};
-            hm_real a0[2] = {HM_R(0.0), HM_R(0.0)}, a1[2] = {HM_R(0.0), HM_R(0.0)};
             hm_real tz_l[2] = {HM_R(0.0), HM_R(0.0)}, bw_l[2] = {HM_R(0.0), HM_R(0.0)};
-            hm_real qv_l[2] = {HM_R(0.0), HM_R(0.0)}, vPv_l[2] = {HM_R(0.0), HM_R(0.0)};
-            hm_real rp_l[2] = {HM_R(0.0), HM_R(0.0)}, rd_l[2] = {HM_R(0.0), HM_R(0.0)};
+            hm_real rp_l[2] = {HM_R(0.0), HM_R(0.0)};
 
             /* soft rows (ocp_qp_ipm_rows_a, above): their parts summed into the stage */
             for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
                 const hm_real d0 = sr->sd0[j], d1 = sr->sd1[j], we = sr->sdr[j];
-                const hm_real e = sr->sdsb[j], cmu = sr->se[j], z = sr->sz[j];
+                const hm_real e = sr->sdsb[j], cmu = sr->se[j];
                 h00[0] += we * d0 * d0;
                 h10[0] += we * d0 * d1;
                 h11[0] += we * d1 * d1;
@@ -836,8 +814,6 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                 g1[0] -= d1 * e;
                 m0[0] -= d0 * cmu;
                 m1[0] -= d1 * cmu;
-                a0[0] -= d0 * z;
-                a1[0] -= d1 * z;
             }
             /* hard rows, in pairs */
             for (j = 0; j < sn->nh2; j += 2) {
@@ -864,8 +840,6 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                     g1[l] -= d1 * wr;
                     m0[l] -= d0 * wz;
                     m1[l] -= d1 * wz;
-                    a0[l] -= d0 * z;
-                    a1[l] -= d1 * z;
                     tz_l[l] += msk * t * z;
                     bw_l[l] -= msk * lg * z;
                     rp_l[l] = OCP_QP_IPM_MAX(rp_l[l], OCP_QP_IPM_ABS(t + rho));
@@ -878,27 +852,133 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
             hf[HM_NU + 1] += g1[0] + g1[1];
             hmu[HM_NU] += m0[0] + m0[1];
             hmu[HM_NU + 1] += m1[0] + m1[1];
-            atw[HM_NU] += a0[0] + a0[1];
-            atw[HM_NU + 1] += a1[0] + a1[1];
             tz += tz_l[0] + tz_l[1];
             bw += bw_l[0] + bw_l[1];
-            qv += qv_l[0] + qv_l[1];
-            vPv += vPv_l[0] + vPv_l[1];
             rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_MAX(rp_l[0], rp_l[1]));
-            rd = OCP_QP_IPM_MAX(rd, OCP_QP_IPM_MAX(rd_l[0], rd_l[1]));
         } else {
             sn->Hpp[0] = sn->Hpp[1] = sn->Hpp[2] = HM_R(0.0);
         }
 
-        /* stationarity of (u, x): r = P v + q + A' w, and the predictor's gradient r + A_I' W rho.
-         * The parts absent at stage 0 (x) and stage N (u) are exact zeros in every term (no cost,
-         * no bounds, no rows, no dynamics there; v stays 0), so the sums and maxima run over all. */
-        ocp_qp_ipm_hess_mul(sn, ux, Pux);
+        /* stationarity of (u, x) by the recurrence, and the predictor's gradient r + A_I' W rho.
+         * The parts absent at stage 0 (x) and stage N (u) are exact zeros in every term. */
         for (i = 0; i < HM_QP_NUX; i++) {
-            const hm_real ri = Pux[i] + sn->q[i] + atw[i];
+            const hm_real ri = keep * sn->rv[i];
+            sn->rv[i] = ri;
             sn->ha[i] = ri + hf[i];
             sn->hmu[i] = hmu[i];
             sn->Hd[i] = Hd[i];
+            rd_v[i] = OCP_QP_IPM_MAX(rd_v[i], OCP_QP_IPM_ABS(ri));
+        }
+    }
+    for (i = 0; i < HM_QP_NUX; i++) rd_eq = OCP_QP_IPM_MAX(rd_eq, rd_v[i]);
+    for (i = 0; i < HM_NX; i++) rp_eq = OCP_QP_IPM_MAX(rp_eq, rpe_v[i]);
+    sm->bw = bw;
+    sm->tz = tz;
+    sm->vz = vz;
+    sm->rp_in = rp;
+    sm->rd_in = rd;
+    sm->rp_eq = rp_eq;
+    sm->rd_eq = rd_eq;
+    sm->rp = OCP_QP_IPM_MAX(rp, rp_eq);
+    sm->rd = OCP_QP_IPM_MAX(rd, rd_eq);
+    sm->qv_in = qv;
+    sm->vPv_in = vPv;
+    /* not measured yet: the stage measures (ocp_qp_ipm_stage_measures) and the inequality measures
+     * (ocp_qp_ipm_row_measures); neutral for the normalisation and the certificate, and no natural
+     * residual small enough to declare a solution */
+    sm->exact = 0;
+    sm->measured = 0;
+    sm->qv = sm->vPv = HM_R(0.0);
+    sm->atw = sm->pv = sm->av_eq = HM_R(0.0);
+    sm->av_ineq = sm->nt = sm->atw_s = sm->pv_s = HM_R(0.0);
+    sm->ncr = HM_INF;
+}
+
+/* The exact stage measures of the iterate left by pass A (see ocp_qp_ipm_sums): the residuals of
+ * the dynamics and of the stationarity of (u, x) evaluated afresh (the predictor's gradient ha
+ * corrected by the difference to the recurred ones), the norms of A' w, P v and A_E v, and q' v,
+ * v' P v. */
+HM_FUNC void ocp_qp_ipm_stage_measures(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws,
+                                       ocp_qp_ipm_sums *restrict sm)
+{
+    hm_real qv = HM_R(0.0), vPv = HM_R(0.0), atw_n = HM_R(0.0), pv_n = HM_R(0.0), aveq_n = HM_R(0.0);
+    hm_real rd_eq = HM_R(0.0), rp_eq = HM_R(0.0);
+    hm_real rd_v[HM_QP_NUX], pv_v[HM_QP_NUX], atw_v[HM_QP_NUX], eq_v[HM_NX], rpe_v[HM_NX];
+    const hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
+    const hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
+    int n, i, j, k;
+
+    for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = pv_v[i] = atw_v[i] = HM_R(0.0);
+    for (i = 0; i < HM_NX; i++) eq_v[i] = rpe_v[i] = HM_R(0.0);
+    for (n = 0; n <= HM_N; n++) {
+        hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+        const hm_real *restrict ux = sn->ux;
+        hm_real Pux[HM_QP_NUX], atw[HM_QP_NUX];
+
+        /* dynamics n - 1 -> n: x_n - A x_{n-1} - B u_{n-1} = b_{n-1} */
+        if (n > 0) {
+            hm_ocp_qp_ipm_stage *restrict sp = &ws->u.f.st[n - 1];
+            const hm_real *restrict A = qp->A[n - 1];
+            const hm_real *restrict B = qp->B[n - 1];
+            const hm_real *restrict up = sp->ux;
+            hm_real e[HM_NX];
+            for (i = 0; i < HM_NX; i++) e[i] = ux[HM_NU + i] - B[i] * up[0] - B[i + HM_NX] * up[1];
+            /* all of A, also where its first columns are e_0, e_1 (sp->a_id): the products with
+             * 1 and 0 are exact, and a uniform loop keeps e in registers (the special case
+             * stored half of e and reloaded it whole, a failed store forwarding per stage) */
+            if (n > 1) {
+                for (k = 0; k < HM_NX; k++) {
+                    const hm_real xk = up[HM_NU + k];
+                    for (i = 0; i < HM_NX; i++) e[i] -= A[i + k * HM_NX] * xk;
+                }
+            }
+            for (i = 0; i < HM_NX; i++) {
+                const hm_real ri = e[i] - sp->beq[i];
+                sp->ry[i] = -ri;
+                eq_v[i] = OCP_QP_IPM_MAX(eq_v[i], OCP_QP_IPM_ABS(e[i]));
+                rpe_v[i] = OCP_QP_IPM_MAX(rpe_v[i], OCP_QP_IPM_ABS(ri));
+            }
+        }
+
+        /* A' w: the dynamics, the bound pairs (pass A's parts), the rows */
+        if (n < HM_N) {
+            const hm_real *restrict B = qp->B[n];
+            const hm_real *restrict y = sn->y;
+            atw[0] = -(B[0] * y[0] + B[1] * y[1] + B[2] * y[2] + B[3] * y[3]);
+            atw[1] = -(B[4] * y[0] + B[5] * y[1] + B[6] * y[2] + B[7] * y[3]);
+        } else {
+            atw[0] = atw[1] = HM_R(0.0);
+        }
+        if (n > 0) {
+            const hm_real *restrict ym = ws->u.f.st[n - 1].y;
+            for (i = 0; i < HM_NX; i++) atw[HM_NU + i] = ym[i];
+            if (n < HM_N) {
+                const hm_real *restrict A = qp->A[n];
+                const hm_real *restrict y = sn->y;
+                for (i = 0; i < HM_NX; i++) {
+                    const hm_real *restrict a = &A[i * HM_NX];
+                    atw[HM_NU + i] -= (a[0] * y[0] + a[1] * y[1]) + (a[2] * y[2] + a[3] * y[3]);
+                }
+            }
+            for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
+                atw[HM_NU] -= sr->sd0[j] * sr->sz[j];
+                atw[HM_NU + 1] -= sr->sd1[j] * sr->sz[j];
+            }
+            for (j = 0; j < sn->nh2; j++) {
+                atw[HM_NU] -= sn->hd0[j] * sn->hz[j];
+                atw[HM_NU + 1] -= sn->hd1[j] * sn->hz[j];
+            }
+        } else {
+            for (i = 0; i < HM_NX; i++) atw[HM_NU + i] = HM_R(0.0);
+        }
+        for (k = 0; k < bd->nbp; k++) atw[bd->bc[k]] += bd->atw[k][n];
+
+        /* stationarity of (u, x): r = P v + q + A' w */
+        ocp_qp_ipm_hess_mul(sn, ux, Pux);
+        for (i = 0; i < HM_QP_NUX; i++) {
+            const hm_real ri = Pux[i] + sn->q[i] + atw[i];
+            sn->ha[i] += ri - sn->rv[i];
+            sn->rv[i] = ri;
             atw_v[i] = OCP_QP_IPM_MAX(atw_v[i], OCP_QP_IPM_ABS(atw[i]));
             pv_v[i] = OCP_QP_IPM_MAX(pv_v[i], OCP_QP_IPM_ABS(Pux[i]));
             rd_v[i] = OCP_QP_IPM_MAX(rd_v[i], OCP_QP_IPM_ABS(ri));
@@ -911,25 +991,22 @@ HM_FUNC void ocp_qp_ipm_pass_a(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
     for (i = 0; i < HM_QP_NUX; i++) {
         atw_n = OCP_QP_IPM_MAX(atw_n, atw_v[i]);
         pv_n = OCP_QP_IPM_MAX(pv_n, pv_v[i]);
-        rd = OCP_QP_IPM_MAX(rd, rd_v[i]);
+        rd_eq = OCP_QP_IPM_MAX(rd_eq, rd_v[i]);
     }
     for (i = 0; i < HM_NX; i++) {
         aveq_n = OCP_QP_IPM_MAX(aveq_n, eq_v[i]);
-        rp = OCP_QP_IPM_MAX(rp, rpe_v[i]);
+        rp_eq = OCP_QP_IPM_MAX(rp_eq, rpe_v[i]);
     }
-    sm->qv = qv;
-    sm->bw = bw;
-    sm->vPv = vPv;
-    sm->tz = tz;
+    sm->qv = sm->qv_in + qv;
+    sm->vPv = sm->vPv_in + vPv;
     sm->atw = atw_n;
     sm->pv = pv_n;
     sm->av_eq = aveq_n;
-    sm->rd = rd;
-    sm->rp = rp;
-    /* not measured yet: neutral for the normalisation and the certificate, and no natural residual
-     * small enough to declare a solution */
-    sm->av_ineq = sm->nt = sm->atw_s = sm->pv_s = HM_R(0.0);
-    sm->ncr = HM_INF;
+    sm->rp_eq = rp_eq;
+    sm->rd_eq = rd_eq;
+    sm->rp = OCP_QP_IPM_MAX(sm->rp_in, rp_eq);
+    sm->rd = OCP_QP_IPM_MAX(sm->rd_in, rd_eq);
+    sm->exact = 1;
 }
 
 /* The norms over the inequalities of the iterate left by pass A (see ocp_qp_ipm_sums). */
@@ -981,6 +1058,7 @@ HM_FUNC void ocp_qp_ipm_row_measures(const hm_ocp_qp_ipm_ws *restrict ws, ocp_qp
     sm->ncr = ncr;
     sm->atw_s = atw_s;
     sm->pv_s = pv_s;
+    sm->measured = 1;
 }
 
 /* ------------------------------------------------------------------------------------------------
@@ -1792,6 +1870,9 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
     ocp_qp_ipm_sums sm;
     hm_real mu0 = HM_R(1.0), alpha = HM_R(0.0), alpha_prev = HM_R(1.0), rp0 = HM_R(0.0);
     hm_real mu_hist[OCP_QP_IPM_STALL_ITERS] = {HM_R(0.0)};
+    /* the last stage measures' dual normalisation and cost; whether they were taken near passing */
+    hm_real nd_seen = HM_R(0.0), pcost_seen = HM_R(0.0);
+    int near_seen = 0;
 
     ws->out.iter = 0;
     ws->out.unbounded = 0;
@@ -1815,7 +1896,12 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         hm_real mu, res_p, res_d, pcost, gap, gap_rel, sigma, smu, alpha_aff, mu_aff, frac, ratio;
         ocp_qp_ipm_pred pr;
 
-        OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_A, ocp_qp_ipm_pass_a(qp, ws, alpha, &sm));
+        OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_A, ocp_qp_ipm_pass_a(ws, alpha, &sm));
+        /* the stage measures in the first iteration, and where the certificate test needs A' w:
+         * b' w < 0 and the soft slacks' part of A' w (the inequality measures) small enough */
+        if (ws->out.iter > 0 && sm.bw < HM_R(0.0)) ocp_qp_ipm_row_measures(ws, &sm);
+        if (!arg->recurrence || ws->out.iter == 0 || (sm.bw < HM_R(0.0) && sm.atw_s <= arg->tol_infeas * -sm.bw))
+            OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_A, ocp_qp_ipm_stage_measures(qp, ws, &sm));
         mu = sm.tz / mdeg;
         if (ws->out.iter == 0) {
             mu0 = mu;
@@ -1823,8 +1909,8 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         }
         ws->out.mu = mu;
         /* a NaN anywhere in the iterate reaches one of these sums (t, z, s through t'z; v through
-         * q'v and v'Pv, which multiply every entry; y through b'w) */
-        if (!isfinite(mu + sm.rd + sm.rp + sm.qv + sm.bw + sm.vPv)) {
+         * 0 * v; y through b'w, whose rows b multiply every entry (0 * NaN is NaN)) */
+        if (!isfinite(mu + sm.rd + sm.rp + sm.vz + sm.bw + sm.qv + sm.vPv)) {
             status = HM_QP_NONFINITE;
             break;
         }
@@ -1832,23 +1918,44 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         /* termination tests. Their normalisations take the norms of the stage vectors and, where
          * the residuals are within OCP_QP_IPM_MEASURE_NEAR of passing already (or the iterate may
          * be a certificate), the norms over the inequalities: those only ever enlarge the
-         * normalisation, and cost a pass over the rows. */
-        {
-            const hm_real np_stage = OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_b), sm.av_eq);
-            const hm_real nd_stage = OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_q), OCP_QP_IPM_MAX(sm.pv, sm.atw));
-            if ((sm.rp <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * np_stage
-                 && sm.rd <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * nd_stage)
-                || (sm.bw < HM_R(0.0) && sm.atw <= arg->tol_infeas * -sm.bw))
+         * normalisation, and cost a pass over the rows. Between stage measures the primal one is
+         * bounded from above by ||A_E v|| <= ||b_E|| + ||A_E v - b_E|| (so res_p is not
+         * overstated), the dual one estimated by the last stage measures. */
+        for (;;) {
+            const hm_real np_lb = OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_b);
+            const hm_real nd_lb = OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_q);
+            const hm_real np_stage = sm.exact ? OCP_QP_IPM_MAX(np_lb, sm.av_eq) : OCP_QP_IPM_MAX(np_lb, ws->norm_b + sm.rp_eq);
+            const hm_real nd_stage = OCP_QP_IPM_MAX(nd_lb, sm.exact ? OCP_QP_IPM_MAX(sm.pv, sm.atw) : nd_seen);
+            if (!sm.measured
+                && ((sm.rp <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * np_stage
+                     && sm.rd <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * nd_stage)
+                    || (sm.bw < HM_R(0.0) && sm.atw <= arg->tol_infeas * -sm.bw)))
                 ocp_qp_ipm_row_measures(ws, &sm);
             res_p = sm.rp / OCP_QP_IPM_MAX(np_stage, OCP_QP_IPM_MAX(sm.av_ineq, sm.nt));
             res_d = sm.rd / OCP_QP_IPM_MAX(nd_stage, OCP_QP_IPM_MAX(sm.pv_s, sm.atw_s));
-            sm.atw = OCP_QP_IPM_MAX(sm.atw, sm.atw_s);
+            gap = sm.tz * cinv;
+            if (sm.exact) {
+                nd_seen = OCP_QP_IPM_MAX(sm.pv, sm.atw);
+                pcost_seen = (sm.qv + HM_R(0.5) * sm.vPv) * cinv;
+                break;
+            }
+            /* Every test below that needs res_p, res_d <= tol decides on exact values: the stage
+             * measures are taken once the residuals are near passing (the first time, to renew
+             * the estimates), and from then on when the gap test or the stall test could pass. */
+            if (!(res_p <= arg->tol && res_d <= OCP_QP_IPM_STAGE_NEAR * arg->tol)) break;
+            if (near_seen && !(gap <= arg->tol
+                               || gap <= OCP_QP_IPM_STAGE_NEAR * arg->tol * OCP_QP_IPM_MAX(HM_R(1.0), hm_fabs(pcost_seen)))
+                && !(ws->out.iter >= OCP_QP_IPM_STALL_ITERS
+                     && mu > HM_R(0.25) * mu_hist[ws->out.iter % OCP_QP_IPM_STALL_ITERS]))
+                break;
+            near_seen = 1;
+            OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_A, ocp_qp_ipm_stage_measures(qp, ws, &sm));
         }
+        sm.atw = OCP_QP_IPM_MAX(sm.atw, sm.atw_s);
         /* the complementarity t' z (= primal - dual cost once the residuals vanish, but without the
          * cancellation of those two large numbers), absolute and relative to the cost, in the units
          * of the data */
         pcost = (sm.qv + HM_R(0.5) * sm.vPv) * cinv;
-        gap = sm.tz * cinv;
         gap_rel = gap / OCP_QP_IPM_MAX(HM_R(1.0), hm_fabs(pcost));
         ws->out.res_primal = res_p;
         ws->out.res_dual = res_d;
@@ -1856,7 +1963,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         /* and the natural residual of complementarity, max min(t, z): the product t z bounds the
          * distance to the solution only through its square root when a multiplier is small, the
          * natural residual linearly; near-degenerate QPs need it, others meet it with the gap */
-        if (res_p <= arg->tol && res_d <= arg->tol && (gap <= arg->tol || gap_rel <= arg->tol)
+        if (sm.exact && res_p <= arg->tol && res_d <= arg->tol && (gap <= arg->tol || gap_rel <= arg->tol)
             && sm.ncr <= HM_R(10.0) * arg->tol) {
             status = HM_QP_SOLVED;
             break;
@@ -1912,7 +2019,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
          * blocks every direction after a few roundings, and the iteration cycles between a blocked
          * affine step and a short centring step (seen on RTI QPs with screened rows: mu 1e-7 to
          * 3e-7 and back for 40 iterations). The embedding has no such pair. */
-        if (ws->out.iter >= OCP_QP_IPM_STALL_ITERS && res_p <= arg->tol && res_d <= arg->tol
+        if (sm.exact && ws->out.iter >= OCP_QP_IPM_STALL_ITERS && res_p <= arg->tol && res_d <= arg->tol
             && mu > HM_R(0.25) * mu_hist[ws->out.iter % OCP_QP_IPM_STALL_ITERS]) {
             fallback = 1;
             break;

@@ -16,6 +16,11 @@
  * weights z / t of the Newton matrix are capped (ocp_qp_ipm.c) so that the Riccati recursion keeps
  * its accuracy near the solution.
  *
+ * The residuals of the linear equations (dynamics, stationarity of (u, x)) follow the steps by
+ * their recurrence r <- (1 - alpha) r (a Newton step solves those equations), and are evaluated
+ * afresh in the first iteration and whenever a termination test could pass (arg->recurrence; 0:
+ * afresh in every iteration, as a reference solve wants).
+ *
  * Termination, checked at each iterate before the next factorisation:
  *   SOLVED      primal and dual residuals (inf-norms), each divided by max(1, norms of the terms it
  *               is made of), and the complementarity t' z (the duality gap, in the units of the
@@ -56,7 +61,7 @@
 #include "hm_common.h"
 
 /* max_iter 50, tol 1e-6 (1e-4 in single precision), tol_infeas 1e-8 (1e-4), step_frac 0.99,
- * min_step 1e-8, no polish, no stop hook. */
+ * min_step 1e-8, no polish, residual recurrence, no stop hook. */
 HM_FUNC void ocp_qp_ipm_arg_set_default(hm_ocp_qp_ipm_arg *arg);
 
 /* Solve qp; returns an enum hm_qp_status (also in ws->out.status). */
