@@ -1120,7 +1120,6 @@ HM_FUNC void ocp_qp_ipm_stage_step(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_w
 HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *restrict ws,
                                ocp_qp_ipm_pred *restrict pr)
 {
-    hm_real dy[HM_NX];
     hm_real ratio = HM_R(0.0), tdz = HM_R(0.0), dtdz = HM_R(0.0);
     hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
@@ -1129,7 +1128,7 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
      * (pass A has taken the last one) */
     for (i = 0; i < HM_NX; i++) ws->u.f.st[0].dux[HM_NU + i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
-        ocp_qp_ipm_stage_step(qp, ws, n, dy);
+        ocp_qp_ipm_stage_step(qp, ws, n, NULL);   /* the predictor's dy is never used */
         {
             hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
             const hm_real *restrict dux = sn->dux;

@@ -353,10 +353,10 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp
     } else {
         for (i = 0; i < HM_NX; i++) xnew[i] = sn->ry[i] - B[i] * v0 - B[i + HM_NX] * v1;
     }
-    ocp_qp_kkt_mv4(sn1->P, xnew, t);
-    for (i = 0; i < HM_NX; i++) {
-        xn[i] = xnew[i];
-        dy[i] = -(t[i] + sn1->p[i]);
+    for (i = 0; i < HM_NX; i++) xn[i] = xnew[i];
+    if (dy) {
+        ocp_qp_kkt_mv4(sn1->P, xnew, t);
+        for (i = 0; i < HM_NX; i++) dy[i] = -(t[i] + sn1->p[i]);
     }
 }
 

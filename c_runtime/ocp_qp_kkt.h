@@ -55,7 +55,8 @@ HM_FUNC void ocp_qp_kkt_backward_stage(const hm_ocp_qp *qp, hm_ocp_qp_ipm_stage 
                                        const hm_ocp_qp_ipm_stage *sn1, int n, const hm_real *h);
 
 /* Stage n < HM_N of the forward substitution: from the state step x (zero for n = 0) the input
- * step u, the next state step xn = A x + B u + sn->ry and the multiplier step dy of the dynamics. */
+ * step u, the next state step xn = A x + B u + sn->ry and, unless dy is NULL (the interior-point
+ * predictor needs no multiplier step), the multiplier step dy of the dynamics. */
 HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_stage *sn,
                                       const hm_ocp_qp_ipm_stage *sn1, int n, const hm_real *x, hm_real *u,
                                       hm_real *xn, hm_real *dy);
