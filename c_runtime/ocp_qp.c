@@ -117,10 +117,12 @@ HM_FUNC int ocp_qp_check(const hm_ocp_qp *qp)
     return 0;
 }
 
-/* max that propagates a NaN in b, so that a broken solution cannot look like a good one */
+/* max that propagates a NaN in b, so that a broken solution cannot look like a good one. The two
+ * tests joined by | (not ||): one select, no branch (the branches were a third of
+ * ocp_qp_res_compute's time). */
 HM_FUNC hm_real ocp_qp_max(hm_real a, hm_real b)
 {
-    return (b > a || isnan(b)) ? b : a;
+    return ((b > a) | (b != b)) ? b : a;
 }
 
 /* Violation of lb <= v <= ub, complementarity and multiplier signs of one bounded component. */
