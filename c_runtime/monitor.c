@@ -24,22 +24,34 @@ static int monitor_state_ok(const hm_real *x)
            hm_fabs(x[2]) <= HM_MONITOR_MAX_ANGLE && hm_fabs(x[3]) <= HM_MONITOR_MAX_SPEED;
 }
 
+/* The present humans' predicted positions, in one sweep without early exits (the step checks
+ * (N + 1) N_h of them, twice): a comparison with NaN or an infinity is false, so the range test
+ * alone also rejects non-finite entries. */
+static int monitor_predictions_ok(const hm_input *in)
+{
+    int n, j, bad = 0;
+    for (n = 0; n <= HM_N; n++) {
+        for (j = 0; j < in->n_humans; j++) {
+            const hm_real *p = in->humans_pred[n][j];
+            bad |= !(hm_fabs(p[0]) <= HM_MONITOR_MAX_POSITION) | !(hm_fabs(p[1]) <= HM_MONITOR_MAX_POSITION);
+        }
+    }
+    return !bad;
+}
+
 /* 1 when every input that takes part in the step is usable. check_x0 = 0 for the preparation
  * phase, which runs before the measurement. Entries of absent humans are not read. */
 HM_FUNC int monitor_check_input(const hm_input *in, int check_x0)
 {
-    int n, j;
+    int j;
     if (check_x0 && !monitor_state_ok(in->x0)) return 0;
     if (!monitor_state_ok(in->goal)) return 0;
     if (in->n_humans < 0 || in->n_humans > HM_NG - 1) return 0;
     if (in->has_obstacle != 0 && in->has_obstacle != 1) return 0;
     if (in->has_obstacle && !monitor_position_ok(in->obstacle)) return 0;
-    for (j = 0; j < in->n_humans; j++) {
+    for (j = 0; j < in->n_humans; j++)
         if (!monitor_position_ok(in->humans_now[j])) return 0;
-        for (n = 0; n <= HM_N; n++)
-            if (!monitor_position_ok(in->humans_pred[n][j])) return 0;
-    }
-    return 1;
+    return monitor_predictions_ok(in);
 }
 
 static int monitor_nonneg(hm_real v)
