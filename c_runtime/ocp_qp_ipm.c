@@ -47,7 +47,8 @@ typedef char ocp_qp_ipm_nnp_matches[sizeof(((hm_ocp_qp_ipm_bounds *)0)->v[0]) ==
 #endif
 
 /* The termination tests measure the inequalities once the residuals are within this factor of
- * passing on the stage vectors' normalisation alone (ocp_qp_ipm_solve). */
+ * passing on the stage vectors' normalisation alone and a test that ends the solve could pass
+ * (ocp_qp_ipm_solve). */
 #define OCP_QP_IPM_MEASURE_NEAR HM_R(1e3)
 
 /* Between stage measures the dual residual and the gap are compared with tol times this factor
@@ -1915,38 +1916,40 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         }
 
         /* termination tests. Their normalisations take the norms of the stage vectors and, where
-         * the residuals are within OCP_QP_IPM_MEASURE_NEAR of passing already (or the iterate may
-         * be a certificate), the norms over the inequalities: those only ever enlarge the
-         * normalisation, and cost a pass over the rows. Between stage measures the primal one is
-         * bounded from above by ||A_E v|| <= ||b_E|| + ||A_E v - b_E|| (so res_p is not
-         * overstated), the dual one estimated by the last stage measures. */
+         * one of the tests below that ends the solve could pass, the norms over the inequalities:
+         * those only ever enlarge the normalisation, and cost a pass over the rows. Between stage
+         * measures the primal one is bounded from above by ||A_E v|| <= ||b_E|| + ||A_E v - b_E||
+         * (so res_p is not overstated there), the dual one and the cost are estimated by the last
+         * stage measures. The tests that need res_p, res_d <= tol decide on exact values: the
+         * stage measures are taken once the residuals are near passing (the first time, to renew
+         * the estimates), and from then on where such a test could pass. */
+        gap = sm.tz * cinv;
         for (;;) {
             const hm_real np_lb = OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_b);
             const hm_real nd_lb = OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_q);
             const hm_real np_stage = sm.exact ? OCP_QP_IPM_MAX(np_lb, sm.av_eq) : OCP_QP_IPM_MAX(np_lb, ws->norm_b + sm.rp_eq);
             const hm_real nd_stage = OCP_QP_IPM_MAX(nd_lb, sm.exact ? OCP_QP_IPM_MAX(sm.pv, sm.atw) : nd_seen);
+            const hm_real pc = sm.exact ? (sm.qv + HM_R(0.5) * sm.vPv) * cinv : pcost_seen;
+            /* the gap test, the stall test or the test of residuals stuck above tol could pass */
+            const int could = gap <= arg->tol
+                              || gap <= OCP_QP_IPM_STAGE_NEAR * arg->tol * OCP_QP_IPM_MAX(HM_R(1.0), hm_fabs(pc))
+                              || (ws->out.iter >= OCP_QP_IPM_STALL_ITERS
+                                  && mu > HM_R(0.25) * mu_hist[ws->out.iter % OCP_QP_IPM_STALL_ITERS])
+                              || (ws->out.iter > 1 && mu < HM_R(1e-2) * mu0 && sm.rp * mu0 > HM_R(1e3) * rp0 * mu);
             if (!sm.measured
-                && ((sm.rp <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * np_stage
+                && ((could && sm.rp <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * np_stage
                      && sm.rd <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * nd_stage)
                     || (sm.bw < HM_R(0.0) && sm.atw <= arg->tol_infeas * -sm.bw)))
                 ocp_qp_ipm_row_measures(ws, &sm);
             res_p = sm.rp / OCP_QP_IPM_MAX(np_stage, OCP_QP_IPM_MAX(sm.av_ineq, sm.nt));
             res_d = sm.rd / OCP_QP_IPM_MAX(nd_stage, OCP_QP_IPM_MAX(sm.pv_s, sm.atw_s));
-            gap = sm.tz * cinv;
             if (sm.exact) {
                 nd_seen = OCP_QP_IPM_MAX(sm.pv, sm.atw);
-                pcost_seen = (sm.qv + HM_R(0.5) * sm.vPv) * cinv;
+                pcost_seen = pc;
                 break;
             }
-            /* Every test below that needs res_p, res_d <= tol decides on exact values: the stage
-             * measures are taken once the residuals are near passing (the first time, to renew
-             * the estimates), and from then on when the gap test or the stall test could pass. */
             if (!(res_p <= arg->tol && res_d <= OCP_QP_IPM_STAGE_NEAR * arg->tol)) break;
-            if (near_seen && !(gap <= arg->tol
-                               || gap <= OCP_QP_IPM_STAGE_NEAR * arg->tol * OCP_QP_IPM_MAX(HM_R(1.0), hm_fabs(pcost_seen)))
-                && !(ws->out.iter >= OCP_QP_IPM_STALL_ITERS
-                     && mu > HM_R(0.25) * mu_hist[ws->out.iter % OCP_QP_IPM_STALL_ITERS]))
-                break;
+            if (near_seen && !could) break;
             near_seen = 1;
             OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_A, ocp_qp_ipm_stage_measures(qp, ws, &sm));
         }
