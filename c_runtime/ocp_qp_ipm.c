@@ -700,12 +700,12 @@ HM_FUNC void ocp_qp_ipm_pass_a(hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha, ocp
     hm_real rd = HM_R(0.0), rp = HM_R(0.0), rd_eq = HM_R(0.0), rp_eq = HM_R(0.0);
     /* The maxima are taken entry by entry across the stages and reduced at the end: the same
      * numbers (max is exact in any order), in vector lanes instead of one scalar chain. */
-    hm_real rd_v[HM_QP_NUX], rpe_v[HM_NX];
+    hm_real rd_v[HM_QP_NUX], rpe_v[HM_NX], vz_v[HM_QP_NUX];
     hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
     int n, i, j, k, l;
 
-    for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = HM_R(0.0);
+    for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = vz_v[i] = HM_R(0.0);
     for (i = 0; i < HM_NX; i++) rpe_v[i] = HM_R(0.0);
 
     /* the step, for all stages before the stage loop reads them: updated inside it, a stage's
@@ -715,7 +715,7 @@ HM_FUNC void ocp_qp_ipm_pass_a(hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha, ocp
         hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
         for (i = 0; i < HM_QP_NUX; i++) {
             sn->ux[i] += alpha * sn->dux[i];
-            vz += HM_R(0.0) * sn->ux[i];
+            vz_v[i] += HM_R(0.0) * sn->ux[i];   /* in lanes: one chain of 306 additions took 3 % */
         }
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) sn->y[i] += alpha * sn->dy[i];
@@ -770,7 +770,6 @@ HM_FUNC void ocp_qp_ipm_pass_a(hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha, ocp
 
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
-        hm_real hf[HM_QP_NUX], hmu[HM_QP_NUX], Hd[HM_QP_NUX];
 
         /* dynamics n -> n + 1, by the recurrence */
         if (n < HM_N) {
@@ -782,18 +781,26 @@ HM_FUNC void ocp_qp_ipm_pass_a(hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha, ocp
             }
             bw += (sn->beq[0] * y[0] + sn->beq[1] * y[1]) + (sn->beq[2] * y[2] + sn->beq[3] * y[3]);
         }
+        /* stationarity of (u, x) by the recurrence. The predictor's gradient r + A_I' W rho, the
+         * stage's diagonal and hmu start from it and take the bound pairs' and the rows' parts
+         * entry by entry, in place: summed in local arrays and copied whole, they were read back
+         * while the entries' stores were in flight (a failed store forwarding per stage). The
+         * parts absent at stage 0 (x) and stage N (u) are exact zeros in every term. */
         for (i = 0; i < HM_QP_NUX; i++) {
-            hf[i] = HM_R(0.0);
-            hmu[i] = HM_R(0.0);
-            Hd[i] = HM_R(0.0);
+            const hm_real ri = keep * sn->rv[i];
+            sn->rv[i] = ri;
+            sn->ha[i] = ri;
+            sn->hmu[i] = HM_R(0.0);
+            sn->Hd[i] = HM_R(0.0);
+            rd_v[i] = OCP_QP_IPM_MAX(rd_v[i], OCP_QP_IPM_ABS(ri));
         }
 
         /* bound pairs (above) */
         for (k = 0; k < bd->nbp; k++) {
             const int c = bd->bc[k];
-            Hd[c] += bd->Hd[k][n];
-            hf[c] += bd->hf[k][n];
-            hmu[c] += bd->hmu[k][n];
+            sn->Hd[c] += bd->Hd[k][n];
+            sn->ha[c] += bd->hf[k][n];
+            sn->hmu[c] += bd->hmu[k][n];
         }
 
         if (n > 0) {
@@ -849,29 +856,21 @@ HM_FUNC void ocp_qp_ipm_pass_a(hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha, ocp
             sn->Hpp[0] = h00[0] + h00[1];
             sn->Hpp[1] = h10[0] + h10[1];
             sn->Hpp[2] = h11[0] + h11[1];
-            hf[HM_NU] += g0[0] + g0[1];
-            hf[HM_NU + 1] += g1[0] + g1[1];
-            hmu[HM_NU] += m0[0] + m0[1];
-            hmu[HM_NU + 1] += m1[0] + m1[1];
+            sn->ha[HM_NU] += g0[0] + g0[1];
+            sn->ha[HM_NU + 1] += g1[0] + g1[1];
+            sn->hmu[HM_NU] += m0[0] + m0[1];
+            sn->hmu[HM_NU + 1] += m1[0] + m1[1];
             tz += tz_l[0] + tz_l[1];
             bw += bw_l[0] + bw_l[1];
             rp = OCP_QP_IPM_MAX(rp, OCP_QP_IPM_MAX(rp_l[0], rp_l[1]));
         } else {
             sn->Hpp[0] = sn->Hpp[1] = sn->Hpp[2] = HM_R(0.0);
         }
-
-        /* stationarity of (u, x) by the recurrence, and the predictor's gradient r + A_I' W rho.
-         * The parts absent at stage 0 (x) and stage N (u) are exact zeros in every term. */
-        for (i = 0; i < HM_QP_NUX; i++) {
-            const hm_real ri = keep * sn->rv[i];
-            sn->rv[i] = ri;
-            sn->ha[i] = ri + hf[i];
-            sn->hmu[i] = hmu[i];
-            sn->Hd[i] = Hd[i];
-            rd_v[i] = OCP_QP_IPM_MAX(rd_v[i], OCP_QP_IPM_ABS(ri));
-        }
     }
-    for (i = 0; i < HM_QP_NUX; i++) rd_eq = OCP_QP_IPM_MAX(rd_eq, rd_v[i]);
+    for (i = 0; i < HM_QP_NUX; i++) {
+        rd_eq = OCP_QP_IPM_MAX(rd_eq, rd_v[i]);
+        vz += vz_v[i];
+    }
     for (i = 0; i < HM_NX; i++) rp_eq = OCP_QP_IPM_MAX(rp_eq, rpe_v[i]);
     sm->bw = bw;
     sm->tz = tz;
