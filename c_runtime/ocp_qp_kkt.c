@@ -333,7 +333,7 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp
 {
     const hm_real *restrict B = qp->B[n];
     const hm_real *restrict L = sn->Ld;
-    hm_real w0 = sn->yk[0], w1 = sn->yk[1], v0, v1, xnew[HM_NX], t[HM_NX];
+    hm_real w0 = sn->yk[0], w1 = sn->yk[1], v0, v1, t[HM_NX];
     int i;
     if (n > 0) {
         w0 += ocp_qp_kkt_dot4(sn->Kx, x);
@@ -349,13 +349,15 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp
         const hm_real e0 = sn->yk[0] * L[0] - L[1] * e1;
         hm_real fx[HM_NX];
         ocp_qp_kkt_mv4(sn->F, x, fx);
-        for (i = 0; i < HM_NX; i++) xnew[i] = (sn->ry[i] - B[i] * e0 - B[i + HM_NX] * e1) + fx[i];
+        for (i = 0; i < HM_NX; i++) xn[i] = (sn->ry[i] - B[i] * e0 - B[i + HM_NX] * e1) + fx[i];
     } else {
-        for (i = 0; i < HM_NX; i++) xnew[i] = sn->ry[i] - B[i] * v0 - B[i + HM_NX] * v1;
+        for (i = 0; i < HM_NX; i++) xn[i] = sn->ry[i] - B[i] * v0 - B[i + HM_NX] * v1;
     }
-    for (i = 0; i < HM_NX; i++) xn[i] = xnew[i];
+    /* the multiplier step reads the state step back from xn: computed into a local array and
+     * copied, it went through the stack on the sequential chain of the states (a store and a
+     * reload more per stage) */
     if (dy) {
-        ocp_qp_kkt_mv4(sn1->P, xnew, t);
+        ocp_qp_kkt_mv4(sn1->P, xn, t);
         for (i = 0; i < HM_NX; i++) dy[i] = -(t[i] + sn1->p[i]);
     }
 }
