@@ -644,15 +644,11 @@ static void ocp_nlp_residuals(hm_solver *s, hm_output *out)
     hm_ocp_qp_res res;
     hm_real gap = HM_R(0.0);
     int n, j, i;
-    for (i = 0; i < HM_NX; i++) {
-        m->x[0][i] = qp->x0[i];
-        gap = hm_fmax(gap, hm_fabs(qp->x0[i]));
-    }
+    for (i = 0; i < HM_NX; i++) gap = hm_fmax(gap, hm_fabs(qp->x0[i]));
     for (n = 0; n <= HM_N; n++)
         for (j = 0; j < HM_NG; j++)
             m->s[n][j] = (j < qp->ng[n] && qp->lg[n][j] > HM_R(0.0)) ? qp->lg[n][j] : HM_R(0.0);
-    ocp_qp_res_compute(qp, m, &res);
-    for (i = 0; i < HM_NX; i++) m->x[0][i] = HM_R(0.0);
+    ocp_qp_res_at_zero_step(qp, m, &res);
     out->kkt_stat = res.stat;
     out->kkt_eq = hm_fmax(res.eq, gap);
     out->kkt_ineq = res.ineq;

@@ -140,8 +140,12 @@ HM_FUNC void ocp_qp_res_bound(hm_real v, hm_real lb, hm_real ub, hm_real lam_lb,
     res->dual = ocp_qp_max(res->dual, ocp_qp_max(-lam_lb, -lam_ub));
 }
 
-HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, hm_ocp_qp_res *out)
+/* The residuals of ocp_qp_res_compute, at sol's primal point or (zero = 1, a constant in each caller
+ * so that the compiler drops the products with zeros) at u = 0 and x_n = 0 for n >= 1, where sol's
+ * u, x_1..x_N are not read; its slacks s are (ocp_qp_res_at_zero_step). */
+HM_KERNEL void ocp_qp_res_eval(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, int zero, hm_ocp_qp_res *out)
 {
+    static const hm_real origin[HM_NU + HM_NX] = {HM_R(0.0)};
     /* accumulated in a local copy: through the caller's pointer every max would be a store and a
      * reload */
     hm_ocp_qp_res local;
@@ -153,36 +157,51 @@ HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, h
     res->ineq = HM_R(0.0);
     res->comp = HM_R(0.0);
     res->dual = HM_R(0.0);
-    for (j = 0; j < HM_NX; j++) res->eq = ocp_qp_max(res->eq, hm_fabs(sol->x[0][j] - qp->x0[j]));
+    if (!zero) {
+        for (j = 0; j < HM_NX; j++) res->eq = ocp_qp_max(res->eq, hm_fabs(sol->x[0][j] - qp->x0[j]));
+    }
 
     for (n = 0; n <= HM_N; n++) {
         /* the problem fixes x_0: stage 0 is evaluated at qp->x0, not at whatever sol->x[0] holds */
-        const hm_real *x = n == 0 ? qp->x0 : sol->x[n];
+        const hm_real *x = n == 0 ? qp->x0 : (zero ? origin : sol->x[n]);
+        const int moved = !zero || n == 0;   /* x_n can be nonzero */
         hm_real gx[HM_NX], gu[HM_NU];
         for (i = 0; i < HM_NX; i++) {
             hm_real acc = qp->q[n][i];
-            for (k = 0; k < HM_NX; k++) acc += qp->Q[n][i + k * HM_NX] * x[k];
+            if (moved) {
+                for (k = 0; k < HM_NX; k++) acc += qp->Q[n][i + k * HM_NX] * x[k];
+                obj += x[i] * (qp->q[n][i] + HM_R(0.5) * (acc - qp->q[n][i]));
+            }
             gx[i] = acc;
-            obj += x[i] * (qp->q[n][i] + HM_R(0.5) * (acc - qp->q[n][i]));
         }
         if (n < HM_N) {
-            const hm_real *u = sol->u[n];
+            const hm_real *u = zero ? origin : sol->u[n];
             for (i = 0; i < HM_NU; i++) {
                 hm_real su = HM_R(0.0), ru = HM_R(0.0);
-                for (k = 0; k < HM_NX; k++) su += qp->S[n][i + k * HM_NU] * x[k];
-                for (k = 0; k < HM_NU; k++) ru += qp->R[n][i + k * HM_NU] * u[k];
+                if (moved) {
+                    for (k = 0; k < HM_NX; k++) su += qp->S[n][i + k * HM_NU] * x[k];
+                }
+                if (!zero) {
+                    for (k = 0; k < HM_NU; k++) ru += qp->R[n][i + k * HM_NU] * u[k];
+                    obj += u[i] * (su + HM_R(0.5) * ru + qp->r[n][i]);
+                }
                 gu[i] = ru + su + qp->r[n][i] - sol->lam_lbu[n][i] + sol->lam_ubu[n][i];
-                obj += u[i] * (su + HM_R(0.5) * ru + qp->r[n][i]);
                 for (k = 0; k < HM_NX; k++) gu[i] += qp->B[n][k + i * HM_NX] * sol->pi[n][k];
             }
             for (k = 0; k < HM_NX; k++) {
-                for (i = 0; i < HM_NU; i++) gx[k] += qp->S[n][i + k * HM_NU] * u[i];
+                if (!zero) {
+                    for (i = 0; i < HM_NU; i++) gx[k] += qp->S[n][i + k * HM_NU] * u[i];
+                }
                 for (i = 0; i < HM_NX; i++) gx[k] += qp->A[n][i + k * HM_NX] * sol->pi[n][i];
             }
             for (i = 0; i < HM_NX; i++) {
-                hm_real acc = qp->b[n][i] - sol->x[n + 1][i];
-                for (k = 0; k < HM_NX; k++) acc += qp->A[n][i + k * HM_NX] * x[k];
-                for (k = 0; k < HM_NU; k++) acc += qp->B[n][i + k * HM_NX] * u[k];
+                hm_real acc = qp->b[n][i] - (zero ? HM_R(0.0) : sol->x[n + 1][i]);
+                if (moved) {
+                    for (k = 0; k < HM_NX; k++) acc += qp->A[n][i + k * HM_NX] * x[k];
+                }
+                if (!zero) {
+                    for (k = 0; k < HM_NU; k++) acc += qp->B[n][i + k * HM_NX] * u[k];
+                }
                 res->eq = ocp_qp_max(res->eq, hm_fabs(acc));
             }
             for (i = 0; i < HM_NU; i++) {
@@ -224,6 +243,16 @@ HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, h
     }
     res->obj = obj;
     *out = local;
+}
+
+HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, hm_ocp_qp_res *out)
+{
+    ocp_qp_res_eval(qp, sol, 0, out);
+}
+
+HM_FUNC void ocp_qp_res_at_zero_step(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, hm_ocp_qp_res *out)
+{
+    ocp_qp_res_eval(qp, sol, 1, out);
 }
 
 HM_FUNC hm_real ocp_qp_res_worst(const hm_ocp_qp_res *res)
