@@ -187,11 +187,10 @@ typedef struct HM_NS(ocp_qp_ipm_bounds) {
     HM_REAL rho[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];   /* predictor right-hand side */
     HM_REAL del[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];   /* predictor dt dz */
     /* per slot and stage: ux[c] of the iterate and of the step (pass C's predictor step until pass
-     * E writes the corrector's); the pair's parts of A' w, of the Newton diagonal and of the
-     * gradients ha, hmu and hdl */
+     * E writes the corrector's); the pair's parts of the Newton diagonal and of the gradients ha,
+     * hmu and hdl */
     HM_REAL v[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
     HM_REAL dv[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
-    HM_REAL atw[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
     HM_REAL Hd[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
     HM_REAL hf[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
     HM_REAL hmu[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];

@@ -383,13 +383,13 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
  * own so that the arrays are restrict parameters: the compiler then runs the stages in vector lanes.
  * ---------------------------------------------------------------------------------------------- */
 
-/* Pass A: the step, the weights and the side's parts of A' w, of the diagonal and the gradients;
- * per stage t z, b z and the residual |rho + t|. */
+/* Pass A: the step, the weights and the side's parts of the diagonal and the gradients; per stage
+ * t z, b z and the residual |rho + t|. (Its part of A' w, sign * z, only the stage measures read.) */
 HM_FUNC void ocp_qp_ipm_bound_side_a(hm_real alpha, hm_real wmax, const hm_real *restrict sg,
                                      const hm_real *restrict b, const hm_real *restrict v,
                                      const hm_real *restrict dt, const hm_real *restrict dz, hm_real *restrict t,
                                      hm_real *restrict z, hm_real *restrict w, hm_real *restrict ti,
-                                     hm_real *restrict zi, hm_real *restrict rho, hm_real *restrict atw,
+                                     hm_real *restrict zi, hm_real *restrict rho,
                                      hm_real *restrict Hd, hm_real *restrict hf, hm_real *restrict hmu,
                                      hm_real *restrict tz, hm_real *restrict bw, hm_real *restrict rp)
 {
@@ -409,7 +409,6 @@ HM_FUNC void ocp_qp_ipm_bound_side_a(hm_real alpha, hm_real wmax, const hm_real 
         ti[n] = tin;
         zi[n] = zin;
         rho[n] = r;
-        atw[n] += s * zn;
         Hd[n] += msk * wn;
         hf[n] += s * wn * r;
         hmu[n] += s * wn * zin;
@@ -741,25 +740,24 @@ HM_FUNC void ocp_qp_ipm_pass_a(hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha, ocp
     }
 
     /* bound pairs, all stages of a slot at once (an absent side has sign 0 and stays at t = z = 1);
-     * their parts of A' w, of the diagonal and of the gradients go to the stage loop below */
+     * their parts of the diagonal and of the gradients go to the stage loop below */
     {
         hm_real tz_v[HM_QP_NNP], bw_v[HM_QP_NNP], rp_v[HM_QP_NNP];
         for (n = 0; n < HM_QP_NNP; n++) tz_v[n] = bw_v[n] = rp_v[n] = HM_R(0.0);
         for (k = 0; k < bd->nbp; k++) {
             hm_real *restrict v = bd->v[k];
             const hm_real *restrict dv = bd->dv[k];
-            hm_real *restrict atw_b = bd->atw[k];
             hm_real *restrict Hd_b = bd->Hd[k];
             hm_real *restrict hf_b = bd->hf[k];
             hm_real *restrict hmu_b = bd->hmu[k];
             for (n = 0; n < HM_QP_NNP; n++) {
                 v[n] += alpha * dv[n];
-                atw_b[n] = Hd_b[n] = hf_b[n] = hmu_b[n] = HM_R(0.0);
+                Hd_b[n] = hf_b[n] = hmu_b[n] = HM_R(0.0);
             }
             for (l = 0; l < 2; l++)
                 ocp_qp_ipm_bound_side_a(alpha, wmax, bd->sg[k][l], bd->b[k][l], v, bd->dt[k][l], bd->dz[k][l],
                                         bd->t[k][l], bd->z[k][l], bd->w[k][l], bd->ti[k][l], bd->zi[k][l],
-                                        bd->rho[k][l], atw_b, Hd_b, hf_b, hmu_b, tz_v, bw_v, rp_v);
+                                        bd->rho[k][l], Hd_b, hf_b, hmu_b, tz_v, bw_v, rp_v);
         }
         for (n = 0; n < HM_QP_NNP; n++) {
             tz += tz_v[n];
@@ -940,7 +938,7 @@ HM_FUNC void ocp_qp_ipm_stage_measures(const hm_ocp_qp *restrict qp, hm_ocp_qp_i
             }
         }
 
-        /* A' w: the dynamics, the bound pairs (pass A's parts), the rows */
+        /* A' w: the dynamics, the rows, the bound pairs (sign * z of each side) */
         if (n < HM_N) {
             const hm_real *restrict B = qp->B[n];
             const hm_real *restrict y = sn->y;
@@ -971,7 +969,8 @@ HM_FUNC void ocp_qp_ipm_stage_measures(const hm_ocp_qp *restrict qp, hm_ocp_qp_i
         } else {
             for (i = 0; i < HM_NX; i++) atw[HM_NU + i] = HM_R(0.0);
         }
-        for (k = 0; k < bd->nbp; k++) atw[bd->bc[k]] += bd->atw[k][n];
+        for (k = 0; k < bd->nbp; k++)
+            atw[bd->bc[k]] += bd->sg[k][0][n] * bd->z[k][0][n] + bd->sg[k][1][n] * bd->z[k][1][n];
 
         /* stationarity of (u, x): r = P v + q + A' w */
         ocp_qp_ipm_hess_mul(sn, ux, Pux);
