@@ -1925,7 +1925,8 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         for (;;) {
             const hm_real np_lb = OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_b);
             const hm_real nd_lb = OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_q);
-            const hm_real np_stage = sm.exact ? OCP_QP_IPM_MAX(np_lb, sm.av_eq) : OCP_QP_IPM_MAX(np_lb, ws->norm_b + sm.rp_eq);
+            const hm_real np_stage = sm.exact ? OCP_QP_IPM_MAX(np_lb, sm.av_eq)
+                                              : OCP_QP_IPM_MAX(np_lb, ws->norm_b + sm.rp_eq);
             const hm_real nd_stage = OCP_QP_IPM_MAX(nd_lb, sm.exact ? OCP_QP_IPM_MAX(sm.pv, sm.atw) : nd_seen);
             const hm_real pc = sm.exact ? (sm.qv + HM_R(0.5) * sm.vPv) * cinv : pcost_seen;
             /* the gap test, the stall test or the test of residuals stuck above tol could pass */
