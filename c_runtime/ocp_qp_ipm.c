@@ -1861,10 +1861,18 @@ HM_FUNC int ocp_qp_ipm_fallback(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
     return status;
 }
 
+/* The primal residual rp fails to fall with mu (from mu0 and rp0 of the first iterate): the
+ * precondition of the stuck-residual fallback (ocp_qp_ipm_solve), which the termination measures
+ * also test for. */
+HM_KERNEL int ocp_qp_ipm_rp_stuck(int iter, hm_real mu, hm_real mu0, hm_real rp, hm_real rp0)
+{
+    return iter > 1 && mu < HM_R(1e-2) * mu0 && rp * mu0 > HM_R(1e3) * rp0 * mu;
+}
+
 HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws,
                              const hm_ocp_qp_ipm_arg *arg)
 {
-    int status, bad = 0, ray = 0, fallback = 0, singular;
+    int status, bad = 0, ray = 0, fallback = 0, singular, stalling;
     ocp_qp_ipm_sums sm;
     hm_real mu0 = HM_R(1.0), alpha = HM_R(0.0), alpha_prev = HM_R(1.0), rp0 = HM_R(0.0);
     hm_real mu_hist[OCP_QP_IPM_STALL_ITERS] = {HM_R(0.0)};
@@ -1922,6 +1930,9 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
          * stage measures are taken once the residuals are near passing (the first time, to renew
          * the estimates), and from then on where such a test could pass. */
         gap = sm.tz * cinv;
+        /* mu has not fallen by 4 over the last OCP_QP_IPM_STALL_ITERS iterations */
+        stalling = ws->out.iter >= OCP_QP_IPM_STALL_ITERS
+                   && mu > HM_R(0.25) * mu_hist[ws->out.iter % OCP_QP_IPM_STALL_ITERS];
         for (;;) {
             const hm_real np_lb = OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_b);
             const hm_real nd_lb = OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_q);
@@ -1932,9 +1943,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
             /* the gap test, the stall test or the test of residuals stuck above tol could pass */
             const int could = gap <= arg->tol
                               || gap <= OCP_QP_IPM_STAGE_NEAR * arg->tol * OCP_QP_IPM_MAX(HM_R(1.0), hm_fabs(pc))
-                              || (ws->out.iter >= OCP_QP_IPM_STALL_ITERS
-                                  && mu > HM_R(0.25) * mu_hist[ws->out.iter % OCP_QP_IPM_STALL_ITERS])
-                              || (ws->out.iter > 1 && mu < HM_R(1e-2) * mu0 && sm.rp * mu0 > HM_R(1e3) * rp0 * mu);
+                              || stalling || ocp_qp_ipm_rp_stuck(ws->out.iter, mu, mu0, sm.rp, rp0);
             if (!sm.measured
                 && ((could && sm.rp <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * np_stage
                      && sm.rd <= OCP_QP_IPM_MEASURE_NEAR * arg->tol * nd_stage)
@@ -2011,7 +2020,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         }
         /* (only while the primal residual is above tol: once it is met, a residual that no longer
          * falls is at its rounding floor, as single precision reaches with mu still falling) */
-        if (ws->out.iter > 1 && res_p > arg->tol && mu < HM_R(1e-2) * mu0 && sm.rp * mu0 > HM_R(1e3) * rp0 * mu) {
+        if (res_p > arg->tol && ocp_qp_ipm_rp_stuck(ws->out.iter, mu, mu0, sm.rp, rp0)) {
             fallback = 1;
             break;
         }
@@ -2020,8 +2029,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
          * blocks every direction after a few roundings, and the iteration cycles between a blocked
          * affine step and a short centring step (seen on RTI QPs with screened rows: mu 1e-7 to
          * 3e-7 and back for 40 iterations). The embedding has no such pair. */
-        if (sm.exact && ws->out.iter >= OCP_QP_IPM_STALL_ITERS && res_p <= arg->tol && res_d <= arg->tol
-            && mu > HM_R(0.25) * mu_hist[ws->out.iter % OCP_QP_IPM_STALL_ITERS]) {
+        if (sm.exact && stalling && res_p <= arg->tol && res_d <= arg->tol) {
             fallback = 1;
             break;
         }
