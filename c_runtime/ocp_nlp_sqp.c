@@ -374,36 +374,22 @@ static int ocp_nlp_qp_usable(int status)
 #define OCP_NLP_SCREEN_MIN HM_R(0.5)   /* smallest screening radius [m] */
 #define OCP_NLP_SCREEN_ROUNDS 3        /* re-solves with violated rows before all rows go in */
 
-static void ocp_nlp_swap_rows(hm_solver *s, int n, int a, int b)
-{
-    hm_ocp_qp *qp = &s->qp;
-    hm_real t;
-    int ti;
-    unsigned char tp;
-    if (a == b) return;
-    t = qp->D[n][a][0]; qp->D[n][a][0] = qp->D[n][b][0]; qp->D[n][b][0] = t;
-    t = qp->D[n][a][1]; qp->D[n][a][1] = qp->D[n][b][1]; qp->D[n][b][1] = t;
-    t = qp->lg[n][a]; qp->lg[n][a] = qp->lg[n][b]; qp->lg[n][b] = t;
-    t = qp->zl[n][a]; qp->zl[n][a] = qp->zl[n][b]; qp->zl[n][b] = t;
-    t = qp->Zl[n][a]; qp->Zl[n][a] = qp->Zl[n][b]; qp->Zl[n][b] = t;
-    ti = qp->soft[n][a]; qp->soft[n][a] = qp->soft[n][b]; qp->soft[n][b] = ti;
-    tp = s->row_perm[n][a]; s->row_perm[n][a] = s->row_perm[n][b]; s->row_perm[n][b] = tp;
-}
-
-/* Rows with margin -lg = d - d_min below the stage's radius first; qp.ng[n] counts them. */
+/* Rows with margin -lg = d - d_min not below the stage's radius leave the QP: their lg is kept in
+ * screened_lg and made absent (-HM_INF), which the QP solvers skip like any absent bound. Nothing
+ * else of the QP moves, so putting a row back is one store. */
 static void ocp_nlp_screen_rows(hm_solver *s)
 {
     hm_ocp_qp *qp = &s->qp;
     int n, j;
     for (n = 0; n <= HM_N; n++) {
         const hm_real radius = s->screen_radius[n];
-        int kept = 0;
-        s->ng_full[n] = qp->ng[n];
-        for (j = 0; j < qp->ng[n]; j++) s->row_perm[n][j] = (unsigned char)j;
         for (j = 0; j < qp->ng[n]; j++) {
-            if (-qp->lg[n][j] < radius) ocp_nlp_swap_rows(s, n, j, kept++);
+            const hm_real lg = qp->lg[n][j];
+            const int out = !(-lg < radius);
+            s->screened[n][j] = (unsigned char)out;
+            s->screened_lg[n][j] = lg;
+            qp->lg[n][j] = out ? -HM_INF : lg;
         }
-        qp->ng[n] = kept;
     }
 }
 
@@ -414,10 +400,12 @@ static int ocp_nlp_admit_violated_rows(hm_solver *s, hm_real tol)
     int n, j, added = 0;
     for (n = 1; n <= HM_N; n++) {
         const hm_real dp0 = s->qp_sol.x[n][0], dp1 = s->qp_sol.x[n][1];
-        for (j = qp->ng[n]; j < s->ng_full[n]; j++) {
-            const hm_real lg = qp->lg[n][j];
-            if (qp->D[n][j][0] * dp0 + qp->D[n][j][1] * dp1 < lg - tol * hm_fmax(HM_R(1.0), hm_fabs(lg))) {
-                ocp_nlp_swap_rows(s, n, j, qp->ng[n]++);
+        for (j = 0; j < qp->ng[n]; j++) {
+            const hm_real lg = s->screened_lg[n][j];
+            if (s->screened[n][j]
+                && qp->D[n][j][0] * dp0 + qp->D[n][j][1] * dp1 < lg - tol * hm_fmax(HM_R(1.0), hm_fabs(lg))) {
+                s->screened[n][j] = 0;
+                qp->lg[n][j] = lg;
                 added++;
             }
         }
@@ -425,46 +413,23 @@ static int ocp_nlp_admit_violated_rows(hm_solver *s, hm_real tol)
     return added;
 }
 
-/* All rows back in their order; the rows left out get their exact multipliers (zero; the slack
+/* All rows back in the QP. With sol: the rows left out get their exact multipliers (zero; the slack
  * bound's the L1 weight) and slack (zero). */
-static void ocp_nlp_unscreen_rows(hm_solver *s)
+static void ocp_nlp_unscreen_rows(hm_solver *s, hm_ocp_qp_sol *sol)
 {
     hm_ocp_qp *qp = &s->qp;
-    hm_ocp_qp_sol *sol = &s->qp_sol;
-    hm_real D[HM_NG][HM_NP], lg[HM_NG], zl[HM_NG], Zl[HM_NG], sl[HM_NG], lam[HM_NG], lam_s[HM_NG];
-    int soft[HM_NG];
     int n, j;
     for (n = 0; n <= HM_N; n++) {
-        const int full = s->ng_full[n];
-        for (j = qp->ng[n]; j < full; j++) {
-            sol->s[n][j] = HM_R(0.0);
-            sol->lam_lg[n][j] = HM_R(0.0);
-            sol->lam_ls[n][j] = qp->soft[n][j] ? qp->zl[n][j] : HM_R(0.0);
+        for (j = 0; j < qp->ng[n]; j++) {
+            if (!s->screened[n][j]) continue;
+            s->screened[n][j] = 0;
+            qp->lg[n][j] = s->screened_lg[n][j];
+            if (sol) {
+                sol->s[n][j] = HM_R(0.0);
+                sol->lam_lg[n][j] = HM_R(0.0);
+                sol->lam_ls[n][j] = qp->soft[n][j] ? qp->zl[n][j] : HM_R(0.0);
+            }
         }
-        for (j = 0; j < full; j++) {
-            const int r = s->row_perm[n][j];
-            D[r][0] = qp->D[n][j][0];
-            D[r][1] = qp->D[n][j][1];
-            lg[r] = qp->lg[n][j];
-            zl[r] = qp->zl[n][j];
-            Zl[r] = qp->Zl[n][j];
-            soft[r] = qp->soft[n][j];
-            sl[r] = sol->s[n][j];
-            lam[r] = sol->lam_lg[n][j];
-            lam_s[r] = sol->lam_ls[n][j];
-        }
-        for (j = 0; j < full; j++) {
-            qp->D[n][j][0] = D[j][0];
-            qp->D[n][j][1] = D[j][1];
-            qp->lg[n][j] = lg[j];
-            qp->zl[n][j] = zl[j];
-            qp->Zl[n][j] = Zl[j];
-            qp->soft[n][j] = soft[j];
-            sol->s[n][j] = sl[j];
-            sol->lam_lg[n][j] = lam[j];
-            sol->lam_ls[n][j] = lam_s[j];
-        }
-        qp->ng[n] = full;
     }
 }
 
@@ -496,13 +461,12 @@ static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int *qp_it
         if (!screen || !ocp_nlp_qp_usable(status)) break;
         if (round == OCP_NLP_SCREEN_ROUNDS) {
             /* pathological: rows keep turning up; the whole QP settles it */
-            int n;
-            for (n = 0; n <= HM_N; n++) s->qp.ng[n] = s->ng_full[n];
+            ocp_nlp_unscreen_rows(s, 0);
             continue;
         }
         if (round > OCP_NLP_SCREEN_ROUNDS || ocp_nlp_admit_violated_rows(s, tol) == 0) break;
     }
-    if (screen) ocp_nlp_unscreen_rows(s);
+    if (screen) ocp_nlp_unscreen_rows(s, &s->qp_sol);
     if (ocp_nlp_qp_usable(status)) ocp_nlp_size_screening(s);
     return status;
 }
@@ -529,18 +493,25 @@ static void ocp_nlp_save_base(hm_solver *s)
         for (i = 0; i < HM_NU; i++) s->u_base[n][i] = s->u[n][i];
 }
 
-/* The QP's multipliers become the NLP's; their primal part is kept zero so that the residuals
- * read the NLP at the iterate (ocp_nlp_residuals). */
+static void ocp_nlp_copy(hm_real *restrict dst, const hm_real *restrict src, int len)
+{
+    int i;
+    for (i = 0; i < len; i++) dst[i] = src[i];
+}
+
+/* The QP's multipliers become the NLP's. Their primal part stays zero (ocp_qp_sol_set_zero at every
+ * cold start; never written), the slacks are set by ocp_nlp_residuals: neither is copied. */
 static void ocp_nlp_take_multipliers(hm_solver *s)
 {
-    int n, i, j;
-    s->mult = s->qp_sol;
-    for (n = 0; n <= HM_N; n++) {
-        for (i = 0; i < HM_NX; i++) s->mult.x[n][i] = HM_R(0.0);
-        for (j = 0; j < HM_NG; j++) s->mult.s[n][j] = HM_R(0.0);
-    }
-    for (n = 0; n < HM_N; n++)
-        for (i = 0; i < HM_NU; i++) s->mult.u[n][i] = HM_R(0.0);
+    hm_ocp_qp_sol *m = &s->mult;
+    const hm_ocp_qp_sol *q = &s->qp_sol;
+    ocp_nlp_copy(&m->pi[0][0], &q->pi[0][0], HM_N * HM_NX);
+    ocp_nlp_copy(&m->lam_lbx[0][0], &q->lam_lbx[0][0], (HM_N + 1) * HM_NX);
+    ocp_nlp_copy(&m->lam_ubx[0][0], &q->lam_ubx[0][0], (HM_N + 1) * HM_NX);
+    ocp_nlp_copy(&m->lam_lbu[0][0], &q->lam_lbu[0][0], HM_N * HM_NU);
+    ocp_nlp_copy(&m->lam_ubu[0][0], &q->lam_ubu[0][0], HM_N * HM_NU);
+    ocp_nlp_copy(&m->lam_lg[0][0], &q->lam_lg[0][0], (HM_N + 1) * HM_NG);
+    ocp_nlp_copy(&m->lam_ls[0][0], &q->lam_ls[0][0], (HM_N + 1) * HM_NG);
 }
 
 /* Solve the QP; when usable, take the full step (real-time iteration). */

@@ -19,13 +19,13 @@ typedef struct HM_NS(solver) {
     int n_active;    /* humans and obstacle rows of the current linearisation */
     int dyn_fresh;   /* 1: qp.A, qp.B are the dynamics' Jacobians at the iterate, which was just
                         simulated (no gaps): the next linearisation need not evaluate them again */
-    /* Row screening (ocp_nlp_sqp.c): rows of stage n whose linearised margin exceeds screen_radius[n]
-     * are left out of the QP (ng_full[n] rows built, qp.ng[n] passed), in the order row_perm, and
-     * checked after. */
+    /* Row screening (ocp_nlp_sqp.c): rows of stage n whose linearised margin is not below
+     * screen_radius[n] are left out of the QP (screened, their lg kept in screened_lg and made
+     * absent in qp.lg) and checked after. */
     HM_REAL screen_radius[HM_N + 1];
     int qp_solves;   /* QPs solved in the current step */
-    int ng_full[HM_N + 1];
-    unsigned char row_perm[HM_N + 1][HM_NG];
+    HM_REAL screened_lg[HM_N + 1][HM_NG];
+    unsigned char screened[HM_N + 1][HM_NG];
     /* The QP of the current linearisation and its solver. */
     HM_NS(ocp_qp) qp;
     HM_NS(ocp_qp_sol) qp_sol;

@@ -181,6 +181,9 @@ class Solver:
         self._h_now = _view(ffi, self._in.humans_now, (nh_alloc, 2), rt)
         self._h_pred = _view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2), rt)
         self._obstacle = _view(ffi, self._in.obstacle, (2,), rt)
+        # the first k humans' rows, for every k, as views made once
+        self._h_now_first = [self._h_now[:k] for k in range(nh_alloc + 1)]
+        self._h_pred_first = [self._h_pred[:, :k] for k in range(nh_alloc + 1)]
         self._out_buffer = ffi.buffer(self._out)
         self._out_dtype = record_dtype(ffi, f"{name}_output")
         self._param_fields = {f: t.type for f, t in ffi.typeof(f"{name}_params").fields}
@@ -220,10 +223,11 @@ class Solver:
             pred = np.asarray(humans_pred, dtype=np.float64)
             if pred.shape != (N + 1, k, 2):
                 raise ValueError(f"humans_pred must have shape (N+1, k, 2) = ({N + 1}, {k}, 2), got {pred.shape}")
-        self._x0[:] = x0a
-        self._goal[:] = ga
-        self._h_now[:k] = now
-        self._h_pred[:, :k] = pred
+        # whole-view assignments ([...]): a slice index costs numpy as much again as the copy
+        self._x0[...] = x0a
+        self._goal[...] = ga
+        self._h_now_first[k][...] = now
+        self._h_pred_first[k][...] = pred
         self._in.n_humans = k
         if obstacle is None:
             self._in.has_obstacle = 0
@@ -231,7 +235,7 @@ class Solver:
             oa = np.asarray(obstacle, dtype=np.float64)
             if oa.shape != (2,):
                 raise ValueError(f"obstacle must have shape (2,) = [ox, oy] or be None, got {oa.shape}")
-            self._obstacle[:] = oa
+            self._obstacle[...] = oa
             self._in.has_obstacle = 1
 
     def _result(self) -> StepResult:
@@ -264,7 +268,7 @@ class Solver:
         x0a = np.asarray(x0, dtype=np.float64)
         if x0a.shape != (4,):
             raise ValueError(f"x0 must have shape (4,) = [px, py, theta, v], got {x0a.shape}")
-        self._x0[:] = x0a
+        self._x0[...] = x0a
         self._c_feedback(self._solver, self._in, self._out)
         return self._result()
 
