@@ -181,6 +181,8 @@ class Solver:
         self._h_now = _view(ffi, self._in.humans_now, (nh_alloc, 2), rt)
         self._h_pred = _view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2), rt)
         self._obstacle = _view(ffi, self._in.obstacle, (2,), rt)
+        self._nh, self._nodes = dims.nh, N + 1
+        self._counts = (0, False)   # what _in.n_humans, _in.has_obstacle hold (ffi.new zeroes them)
         # the first k humans' rows, for every k, as views made once
         self._h_now_first = [self._h_now[:k] for k in range(nh_alloc + 1)]
         self._h_pred_first = [self._h_pred[:, :k] for k in range(nh_alloc + 1)]
@@ -199,7 +201,7 @@ class Solver:
     # -- inputs -------------------------------------------------------------------------------
     def _load_inputs(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None,
                      humans_pred: ArrayLike | None, obstacle: ArrayLike | None) -> None:
-        N, nh = self.dims.N, self.dims.nh
+        nh = self._nh
         x0a = np.asarray(x0, dtype=np.float64)
         if x0a.shape != (4,):
             raise ValueError(f"x0 must have shape (4,) = [px, py, theta, v], got {x0a.shape}")
@@ -218,28 +220,31 @@ class Solver:
         if humans_pred is None:
             if k:
                 raise ValueError("humans_pred is required when humans_now holds humans: shape (N+1, k, 2)")
-            pred = np.zeros((N + 1, 0, 2))
+            pred = np.zeros((self._nodes, 0, 2))
         else:
             pred = np.asarray(humans_pred, dtype=np.float64)
-            if pred.shape != (N + 1, k, 2):
-                raise ValueError(f"humans_pred must have shape (N+1, k, 2) = ({N + 1}, {k}, 2), got {pred.shape}")
+            if pred.shape != (self._nodes, k, 2):
+                raise ValueError(f"humans_pred must have shape (N+1, k, 2) = ({self._nodes}, {k}, 2), got {pred.shape}")
+        has_obstacle = obstacle is not None
+        if has_obstacle:
+            oa = np.asarray(obstacle, dtype=np.float64)
+            if oa.shape != (2,):
+                raise ValueError(f"obstacle must have shape (2,) = [ox, oy] or be None, got {oa.shape}")
+            self._obstacle[...] = oa
         # whole-view assignments ([...]): a slice index costs numpy as much again as the copy
         self._x0[...] = x0a
         self._goal[...] = ga
         self._h_now_first[k][...] = now
         self._h_pred_first[k][...] = pred
-        self._in.n_humans = k
-        if obstacle is None:
-            self._in.has_obstacle = 0
-        else:
-            oa = np.asarray(obstacle, dtype=np.float64)
-            if oa.shape != (2,):
-                raise ValueError(f"obstacle must have shape (2,) = [ox, oy] or be None, got {oa.shape}")
-            self._obstacle[...] = oa
-            self._in.has_obstacle = 1
+        # the counts only when they change: a cffi attribute store costs as much as an array copy
+        if (k, has_obstacle) != self._counts:
+            self._in.n_humans = k
+            self._in.has_obstacle = int(has_obstacle)
+            self._counts = (k, has_obstacle)
 
     def _result(self) -> StepResult:
-        r = StepResult(np.frombuffer(self._out_buffer[:], dtype=self._out_dtype)[0])
+        # a 0-d record over a bytes copy of the struct (cheaper to make than np.frombuffer(...)[0])
+        r = StepResult(np.ndarray((), self._out_dtype, self._out_buffer[:]))
         if self.log is not None:
             self.log.append(r)
         return r
