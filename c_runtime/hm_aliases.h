@@ -14,6 +14,7 @@ typedef HM_NS(ocp_qp_ipm_bounds) hm_ocp_qp_ipm_bounds;
 typedef HM_NS(ocp_qp_ipm_rows) hm_ocp_qp_ipm_rows;
 typedef HM_NS(ocp_qp_ipm_vec) hm_ocp_qp_ipm_vec;
 typedef HM_NS(ocp_qp_ipm_ws) hm_ocp_qp_ipm_ws;
+typedef HM_NS(ocp_qp_ipm_warm) hm_ocp_qp_ipm_warm;
 typedef HM_NS(ocp_qp_hsde_vec) hm_ocp_qp_hsde_vec;
 typedef HM_NS(ocp_qp_hsde_ws) hm_ocp_qp_hsde_ws;
 

@@ -115,6 +115,11 @@ typedef struct HM_NS(ocp_qp_ipm_arg) {
                                 then leave the residuals far below tol (a reference solve) */
     int (*should_stop)(void *ctx);   /* polled once per iteration; nonzero ends with HM_QP_TIMEOUT */
     void *stop_ctx;
+    int warm_start;          /* 0: the cold start; from the iterate the last solve kept (ws->warm), where it
+                                has the same inequality: 1 its stage n + 1 for stage n (the real-time
+                                iteration's shift), 2 stage n for stage n (a re-solve) */
+    HM_REAL warm_mu;         /* > 0: keep the first iterate after the start with mu <= warm_mu (scaled; the
+                                cold start has mu = 1) for the next solve; 0: keep none */
 } HM_NS(ocp_qp_ipm_arg);
 
 /* Outcome of a solve, as both QP solvers report it (the interior-point solver hands over its
@@ -299,9 +304,22 @@ typedef struct HM_NS(ocp_qp_hsde_ws) {
     HM_REAL yk[HM_N][HM_NU];                /* per solve: Lr^-1 (reduced input gradient) */
 } HM_NS(ocp_qp_hsde_ws);
 
+/* An iterate kept by a solve for the next one's start (arg->warm_start, warm_mu): its slacks and
+ * multipliers (unscaled) by stage and (u, x) component or QP row, so that the next QP may have
+ * other bounds and rows. */
+typedef struct HM_NS(ocp_qp_ipm_warm) {
+    int ready;                                   /* 1: the last solve kept one */
+    HM_REAL bt[HM_N + 1][HM_NU + HM_NX][2];      /* bound sides (lower, upper): slack, 0 if absent */
+    HM_REAL bz[HM_N + 1][HM_NU + HM_NX][2];      /* and multiplier */
+    HM_REAL rt[HM_N + 1][HM_NG], rz[HM_N + 1][HM_NG];     /* rows: slack, multiplier */
+    HM_REAL rs[HM_N + 1][HM_NG], rzs[HM_N + 1][HM_NG];    /* soft rows: s, multiplier of s >= 0 */
+    unsigned char kind[HM_N + 1][HM_NG];         /* 0 absent, 1 soft, 2 hard */
+} HM_NS(ocp_qp_ipm_warm);
+
 /* All memory of a solve. Only the first block is meant for the caller. */
 typedef struct HM_NS(ocp_qp_ipm_ws) {
     HM_NS(ocp_qp_outcome) out;        /* of the last solve */
+    HM_NS(ocp_qp_ipm_warm) warm;      /* kept for the next solve (outside the fallback's memory) */
 
     /* the problem as the solver sees it, and its iterate */
     int m;                            /* inequalities (present bound sides, rows, s >= 0) */

@@ -13,6 +13,10 @@
 #include "ocp_qp.h"
 #include "ocp_qp_ipm.h"
 
+/* Each RTI QP keeps its first iterate with mu <= this (scaled; 1 at the cold start) for the next
+ * step's QP to start from (ocp_qp_ipm.c, warm start). */
+#define OCP_NLP_WARM_MU HM_R(0.1)
+
 static int ocp_nlp_clamp_humans(const hm_input *in)
 {
     int nh = in->n_humans;
@@ -35,6 +39,7 @@ HM_FUNC void ocp_nlp_sqp_init(hm_solver *s, const hm_params *params)
      * only give false positives, and in single precision it did (a large early step whose cost
      * decrease dwarfs its rounding-level residuals, RTI replays with 30 humans). */
     s->ipm_arg.detect_unbounded = 0;
+    s->ipm_arg.warm_mu = OCP_NLP_WARM_MU;
 #if defined(HM_HAVE_POSIX_CLOCK)
     s->clock = hm_clock_posix_ns;
 #else
@@ -49,6 +54,8 @@ HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
     int n, i;
     s->warm = 0;
     s->prepared = 0;
+    s->qp_last_step = 0;
+    s->ipm_ws.warm.ready = 0;
     s->dyn_fresh = 0;
     for (n = 0; n < HM_N; n++)
         for (i = 0; i < HM_NU; i++) s->u[n][i] = HM_R(0.0);
@@ -445,8 +452,10 @@ static void ocp_nlp_size_screening(hm_solver *s)
 }
 
 /* Solve the QP of the current linearisation (its x0 offset set), screened; residuals: the caller
- * reads ipm_ws.out.res. Returns the QP status. */
-static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int *qp_iter)
+ * reads ipm_ws.out.res. shifted: the QP is the last one's a stage on (the real-time iteration's
+ * plan, shifted), and starts from the iterate that the last one kept (ocp_qp_ipm.c, warm start);
+ * the re-solves with more rows start from the first round's. Returns the QP status. */
+static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int shifted, int *qp_iter)
 {
     const int screen = s->params.row_screening && s->screen_radius[0] < HM_INF;
     int status, round;
@@ -455,6 +464,7 @@ static int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int *qp_it
     s->ipm_arg.residuals = residuals;
     if (screen) ocp_nlp_screen_rows(s);
     for (round = 0;; round++) {
+        s->ipm_arg.warm_start = round > 0 ? 2 : shifted;
         status = ocp_qp_ipm_solve(&s->qp, &s->qp_sol, &s->ipm_ws, &s->ipm_arg);
         *qp_iter += s->ipm_ws.out.iter;
         s->qp_solves++;
@@ -515,9 +525,9 @@ static void ocp_nlp_take_multipliers(hm_solver *s)
 }
 
 /* Solve the QP; when usable, take the full step (real-time iteration). */
-static int ocp_nlp_qp_step(hm_solver *s, int *qp_iter)
+static int ocp_nlp_qp_step(hm_solver *s, int shifted, int *qp_iter)
 {
-    const int status = ocp_nlp_qp_solve(s, s->params.qp_tol, 0, qp_iter);
+    const int status = ocp_nlp_qp_solve(s, s->params.qp_tol, 0, shifted, qp_iter);
     if (!ocp_nlp_qp_usable(status)) return status;
     ocp_nlp_save_base(s);
     ocp_nlp_step_from_base(s, HM_R(1.0));
@@ -567,10 +577,11 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
 
 /* Full SQP step with a backtracking line search on the l1 merit (Armijo on the decrease that the
  * QP model predicts); mu grows to stay above the dynamics multipliers, as exactness requires. */
-static int ocp_nlp_qp_line_search_step(hm_solver *s, const hm_input *in, hm_real tol, int *qp_iter)
+static int ocp_nlp_qp_line_search_step(hm_solver *s, const hm_input *in, hm_real tol, int shifted,
+                                       int *qp_iter)
 {
     /* The QP must be solved at least as tightly as the SQP is asked to converge. */
-    const int status = ocp_nlp_qp_solve(s, hm_fmin(s->params.qp_tol, HM_R(0.1) * tol), 1, qp_iter);
+    const int status = ocp_nlp_qp_solve(s, hm_fmin(s->params.qp_tol, HM_R(0.1) * tol), 1, shifted, qp_iter);
     hm_real gaps = HM_R(0.0), pi_max = HM_R(0.0), merit0, predicted, alpha = HM_R(1.0);
     int n, i;
     if (!ocp_nlp_qp_usable(status)) return status;
@@ -631,17 +642,17 @@ static void ocp_nlp_residuals(hm_solver *s, hm_output *out)
 static hm_real ocp_nlp_min_human_distance(const hm_solver *s, const hm_input *in)
 {
     const int nh = ocp_nlp_clamp_humans(in);
-    hm_real best = HM_INF;
+    hm_real best = HM_INF;   /* of the squared distances: one square root (it is monotonic) */
     int n, j;
     for (n = 0; n <= HM_N; n++) {
         for (j = 0; j < nh; j++) {
             const hm_real dx = s->x[n][0] - in->humans_now[j][0];
             const hm_real dy = s->x[n][1] - in->humans_now[j][1];
-            const hm_real d = hm_sqrt(dx * dx + dy * dy);
-            if (d < best) best = d;
+            const hm_real d2 = dx * dx + dy * dy;
+            if (d2 < best) best = d2;
         }
     }
-    return best;
+    return nh > 0 ? hm_sqrt(best) : HM_INF;
 }
 
 static int ocp_nlp_plan_finite(const hm_solver *s)
@@ -802,6 +813,9 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
 {
     unsigned long long t_feedback;
     int qp_status, status, reason;
+    /* the plan moved on by one stage since the previous step's QP, if that step went without a stop */
+    const int shifted = s->warm && s->qp_last_step;
+    s->qp_last_step = 0;
     ocp_nlp_start_clock(s, t_start);
     ocp_nlp_clear_output(out);
     s->qp_solves = 0;
@@ -818,9 +832,9 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
             /* A damped step: with the paper's zero control weights the Gauss-Newton curvature in
              * omega is tiny, and full steps overshoot from one bound of omega to the other. */
             s->merit_mu = HM_R(1.0);
-            qp_status = ocp_nlp_qp_line_search_step(s, in, s->params.qp_tol, &out->qp_iterations);
+            qp_status = ocp_nlp_qp_line_search_step(s, in, s->params.qp_tol, shifted, &out->qp_iterations);
         } else {
-            qp_status = ocp_nlp_qp_step(s, &out->qp_iterations);
+            qp_status = ocp_nlp_qp_step(s, shifted, &out->qp_iterations);
         }
         s->ipm_arg.should_stop = 0;
         s->ipm_arg.stop_ctx = 0;
@@ -847,7 +861,7 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
                 ocp_nlp_set_x0(s, in);
                 s->ipm_arg.should_stop = ocp_nlp_deadline_passed;
                 s->ipm_arg.stop_ctx = s;
-                qp_status = ocp_nlp_qp_step(s, &out->qp_iterations);
+                qp_status = ocp_nlp_qp_step(s, 0, &out->qp_iterations);
                 s->ipm_arg.should_stop = 0;
                 s->ipm_arg.stop_ctx = 0;
                 ocp_nlp_residuals(s, out);
@@ -864,6 +878,9 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
         t_feedback = ocp_nlp_now(s);
     }
     if (reason == HM_STOP_NONE || reason == HM_STOP_UNSAFE_PLAN) s->warm = 1;
+    /* after a stop the next QP starts cold: after the braking retry (HM_STOP_UNSAFE_PLAN) its kept
+     * iterate is the retry's, whose linearisation the plan has left */
+    s->qp_last_step = reason == HM_STOP_NONE;
     if (reason == HM_STOP_NONE) {
         ocp_nlp_report(s, in, out);
     } else {
@@ -915,6 +932,9 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
      * recurrence they end just below it, and at tol = 1e-9 the SQP stalled on that (stationarity
      * 3.5e-7 after 300 iterations, 30 people). */
     s->ipm_arg.recurrence = 0;
+    /* and all of them from the cold start */
+    s->ipm_arg.warm_mu = HM_R(0.0);
+    s->qp_last_step = 0;
     for (k = 0; k < max_iter; k++) {
         ocp_nlp_linearize(s, in, k > 0);
         ocp_nlp_set_x0(s, in);
@@ -923,7 +943,7 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
             status = HM_STATUS_OK;
             break;
         }
-        qp_status = ocp_nlp_qp_line_search_step(s, in, tol, &out->qp_iterations);
+        qp_status = ocp_nlp_qp_line_search_step(s, in, tol, 0, &out->qp_iterations);
         if (!ocp_nlp_qp_usable(qp_status)) {
             status = HM_STATUS_QP_FAILED;
             break;
@@ -938,6 +958,7 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
             status = HM_STATUS_OK;
     }
     s->ipm_arg.recurrence = 1;
+    s->ipm_arg.warm_mu = OCP_NLP_WARM_MU;
     s->prepared = 0;
     out->status = status;
     out->qp_status = qp_status;

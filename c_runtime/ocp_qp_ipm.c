@@ -111,6 +111,8 @@ HM_FUNC void ocp_qp_ipm_arg_set_default(hm_ocp_qp_ipm_arg *arg)
     arg->recurrence = 1;
     arg->should_stop = NULL;
     arg->stop_ctx = NULL;
+    arg->warm_start = 0;
+    arg->warm_mu = HM_R(0.0);
 }
 
 HM_FUNC const char *ocp_qp_status_message(int status)
@@ -1818,6 +1820,105 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
 }
 
 /* ------------------------------------------------------------------------------------------------
+ * Warm start
+ *
+ * Consecutive QPs of the real-time iteration differ little: the new one is the last one shifted by
+ * a stage, linearised at its solution. An interior-point method started from a solution stalls (the
+ * slacks of the active inequalities and the multipliers of the inactive ones are tiny, and wherever
+ * the new data changed which is which, every step to the boundary is short), so the solve keeps an
+ * early, well-centred iterate instead: the first after the start with mu <= arg->warm_mu (0.1 where
+ * the cold start has 1, one or two iterations in). The next solve starts from it, slacks and
+ * multipliers floored at OCP_QP_IPM_WARM_FLOOR (without the floor: 10 to 50 fallbacks per 2,000
+ * closed-loop steps, from two short steps in a row) with v = 0, y = 0, and the inequalities it does
+ * not have from the cold start. Measured on 3 x 2,000 closed-loop steps at N_h = 5: 10.8 instead of
+ * 11.5 iterations per QP, as many fallbacks.
+ * ---------------------------------------------------------------------------------------------- */
+
+#define OCP_QP_IPM_WARM_FLOOR HM_R(0.1)
+
+/* Keep the iterate of pass A in ws->warm (multipliers unscaled: the next QP's scale may differ). */
+HM_FUNC void ocp_qp_ipm_warm_keep(hm_ocp_qp_ipm_ws *ws)
+{
+    const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
+    hm_ocp_qp_ipm_warm *w = &ws->warm;
+    const hm_real cinv = HM_R(1.0) / ws->cost_scale;
+    int n, k, l, j;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        for (k = 0; k < HM_QP_NUX; k++) {
+            w->bt[n][k][0] = w->bt[n][k][1] = HM_R(0.0);
+            w->bz[n][k][0] = w->bz[n][k][1] = HM_R(0.0);
+        }
+        for (k = 0; k < bd->nbp; k++) {
+            for (l = 0; l < 2; l++) {
+                if (bd->sg[k][l][n] == HM_R(0.0)) continue;
+                w->bt[n][bd->bc[k]][l] = bd->t[k][l][n];
+                w->bz[n][bd->bc[k]][l] = bd->z[k][l][n] * cinv;
+            }
+        }
+        for (j = 0; j < HM_NG; j++) w->kind[n][j] = 0;
+        for (j = 0; j < sn->ns; j++) {
+            const int row = sn->soff + j, i = sr->srow[row];
+            w->kind[n][i] = 1;
+            w->rt[n][i] = sr->st[row];
+            w->rz[n][i] = sr->sz[row] * cinv;
+            w->rs[n][i] = sr->ss[row];
+            w->rzs[n][i] = sr->szs[row] * cinv;
+        }
+        for (j = 0; j < sn->nh; j++) {
+            const int i = sn->hrow[j];
+            w->kind[n][i] = 2;
+            w->rt[n][i] = sn->ht[j];
+            w->rz[n][i] = sn->hz[j] * cinv;
+        }
+    }
+    w->ready = 1;
+}
+
+HM_KERNEL hm_real ocp_qp_ipm_warm_floor(hm_real v)
+{
+    return v > OCP_QP_IPM_WARM_FLOOR ? v : OCP_QP_IPM_WARM_FLOOR;
+}
+
+/* Overwrite the cold start (ocp_qp_ipm_setup) with the kept iterate: stage n from kept stage
+ * n + shift (the last stage from itself), wherever the kept stage has the same inequality. */
+HM_FUNC void ocp_qp_ipm_warm_apply(hm_ocp_qp_ipm_ws *ws, int shift)
+{
+    hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
+    const hm_ocp_qp_ipm_warm *w = &ws->warm;
+    const hm_real c = ws->cost_scale;
+    int n, k, l, j;
+    for (n = 0; n <= HM_N; n++) {
+        hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        const int m = n + shift <= HM_N ? n + shift : HM_N;
+        for (k = 0; k < bd->nbp; k++) {
+            for (l = 0; l < 2; l++) {
+                const hm_real t = w->bt[m][bd->bc[k]][l];
+                if (bd->sg[k][l][n] == HM_R(0.0) || !(t > HM_R(0.0))) continue;
+                bd->t[k][l][n] = ocp_qp_ipm_warm_floor(t);
+                bd->z[k][l][n] = ocp_qp_ipm_warm_floor(w->bz[m][bd->bc[k]][l] * c);
+            }
+        }
+        for (j = 0; j < sn->ns; j++) {
+            const int row = sn->soff + j, i = sr->srow[row];
+            if (w->kind[m][i] != 1) continue;
+            sr->st[row] = ocp_qp_ipm_warm_floor(w->rt[m][i]);
+            sr->sz[row] = ocp_qp_ipm_warm_floor(w->rz[m][i] * c);
+            sr->ss[row] = ocp_qp_ipm_warm_floor(w->rs[m][i]);
+            sr->szs[row] = ocp_qp_ipm_warm_floor(w->rzs[m][i] * c);
+        }
+        for (j = 0; j < sn->nh; j++) {
+            const int i = sn->hrow[j];
+            if (w->kind[m][i] != 2) continue;
+            sn->ht[j] = ocp_qp_ipm_warm_floor(w->rt[m][i]);
+            sn->hz[j] = ocp_qp_ipm_warm_floor(w->rz[m][i] * c);
+        }
+    }
+}
+
+/* ------------------------------------------------------------------------------------------------
  * The solve
  * ---------------------------------------------------------------------------------------------- */
 
@@ -1880,6 +1981,9 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
     hm_real nd_seen = HM_R(0.0), pcost_seen = HM_R(0.0);
     int near_seen = 0;
 
+    /* the kept iterate serves one solve at most */
+    const int warm = arg->warm_start && ws->warm.ready;
+    ws->warm.ready = 0;
     ws->out.iter = 0;
     ws->out.unbounded = 0;
     ws->out.polished = 0;
@@ -1896,6 +2000,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         return status;
     }
 
+    if (warm) ocp_qp_ipm_warm_apply(ws, arg->warm_start == 1);
     for (;;) {
         const hm_real mdeg = ws->m > 0 ? (hm_real)ws->m : HM_R(1.0);
         const hm_real cinv = HM_R(1.0) / ws->cost_scale;
@@ -1909,6 +2014,8 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         if (!arg->recurrence || ws->out.iter == 0 || (sm.bw < HM_R(0.0) && sm.atw_s <= arg->tol_infeas * -sm.bw))
             OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_A, ocp_qp_ipm_stage_measures(qp, ws, &sm));
         mu = sm.tz / mdeg;
+        if (arg->warm_mu > HM_R(0.0) && !ws->warm.ready && ws->out.iter > 0 && mu <= arg->warm_mu)
+            ocp_qp_ipm_warm_keep(ws);
         if (ws->out.iter == 0) {
             mu0 = mu;
             rp0 = sm.rp;

@@ -9,7 +9,9 @@
  * A soft row's slack s is the slack of its own bound s >= 0 (no second slack variable). The cost is
  * scaled by 1 / max(largest Hessian diagonal, largest gradient entry) (clipped to [1e-4, 1e4]). The
  * start is v = 0 (soft slacks just satisfying their rows, plus 1), y = 0, t = max(b_I - A_I v, 1),
- * z = 1 / t. One iteration factorises the Newton matrix once (ocp_qp_kkt.h) and solves it twice:
+ * z = 1 / t, or (arg->warm_start) the slacks and multipliers of an early iterate that the previous
+ * solve kept (arg->warm_mu), floored (ocp_qp_ipm.c: consecutive QPs of the real-time iteration).
+ * One iteration factorises the Newton matrix once (ocp_qp_kkt.h) and solves it twice:
  * the affine predictor, and the Mehrotra corrector with centring sigma = (mu_aff / mu)^3. Both
  * target the full primal and dual residuals; the step is a fraction of the largest step that keeps
  * t, z >= 0: arg->step_frac early, rising to 1 - mu/mu_0 late (never above 1 - sqrt(eps)). The
@@ -61,7 +63,7 @@
 #include "hm_common.h"
 
 /* max_iter 50, tol 1e-6 (1e-4 in single precision), tol_infeas 1e-8 (1e-4), step_frac 0.99,
- * min_step 1e-8, no polish, residual recurrence, no stop hook. */
+ * min_step 1e-8, no polish, residual recurrence, no stop hook, cold start, no iterate kept. */
 HM_FUNC void ocp_qp_ipm_arg_set_default(hm_ocp_qp_ipm_arg *arg);
 
 /* Solve qp; returns an enum hm_qp_status (also in ws->out.status). */

@@ -149,6 +149,7 @@ qpt_ocp_qp_sol *qp_harness_sol(void);
 void qp_harness_set_zero(void);
 int qp_harness_check(void);
 void qp_harness_arg(int max_iter, double tol, double tol_infeas, int stop_after, int polish);
+void qp_harness_warm(int warm_start, double warm_mu);
 int qp_harness_solve(void);
 int qp_harness_info(int *iter, int *polls, int *flags, double *res6, double *scaled3, double *mtk3);
 void qp_harness_res(double *res6);
@@ -228,10 +229,12 @@ class Harness:
             self._view(getattr(c, k), self.dtype)[:] = getattr(sol, k).astype(self.dtype).ravel()
 
     def solve(self, qp: QP, max_iter: int = 0, tol: float = 0.0, tol_infeas: float = 0.0,
-              stop_after: int = -1, polish: int = -1) -> Result:
-        """Solve qp; option values 0 / -1 keep the defaults of ocp_qp_ipm_arg_set_default."""
+              stop_after: int = -1, polish: int = -1, warm_start: int = 0, warm_mu: float = 0.0) -> Result:
+        """Solve qp; option values 0 / -1 keep the defaults of ocp_qp_ipm_arg_set_default. warm_mu > 0:
+        keep an iterate for the next solve; warm_start 1 / 2: start from the kept one, shifted or not."""
         self.load(qp)
         self.set_arg(max_iter, tol, tol_infeas, stop_after, polish)
+        self.lib.qp_harness_warm(warm_start, warm_mu)
         status = self.lib.qp_harness_solve()
         return self.result(status)
 

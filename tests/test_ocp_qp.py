@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from tests.qp_harness import (
@@ -187,6 +187,77 @@ def test_longer_horizon_with_more_rows_matches_clarabel(hq_big: Harness, seed: i
     assert r.status == SOLVED and ref.status == "Solved"
     assert primal_error(qp, r.sol, ref) <= PRIMAL_TOL
     assert_kkt(qp, r.sol, r.res["obj"])
+
+
+def _shifted(qp: QP) -> QP:
+    """The QP a stage on, as the real-time iteration's next one: stage n takes stage n + 1's data, the
+    last stage keeps its own."""
+    out = qp.copy()
+    for name in ("A", "B", "b", "Q", "S", "R", "q", "r", "lbx", "ubx", "lbu", "ubu", "ng", "D", "lg", "soft",
+                 "zl", "Zl"):
+        v = getattr(out, name)
+        v[:-1] = v[1:].copy()
+    return out
+
+
+def _perturbed(qp: QP, rng: np.random.Generator, size: float) -> QP:
+    """The same QP with its gradients and right-hand sides moved by about size (relative; absent
+    rows stay absent)."""
+    out = qp.copy()
+    for name in ("q", "r", "b", "lg"):
+        v = getattr(out, name)
+        finite = np.isfinite(v)
+        v[finite] += size * (np.abs(v[finite]) + 0.1) * rng.standard_normal(np.count_nonzero(finite))
+    return out
+
+
+@settings(QP_SETTINGS, max_examples=60)
+@given(seed=seeds, shape=shapes, shifted=st.booleans())
+def test_warm_start_from_the_last_solves_iterate_solves_the_next_qp(hq: Harness, seed: int, shape: Shape,
+                                                                    shifted: bool) -> None:
+    """A solve keeps an early iterate (warm_mu); the next QP (the same with moved data, or its stages
+    shifted by one as in the real-time iteration) starts from it and is solved as accurately as from
+    the cold start, wherever the two QPs' inequalities differ."""
+    rng = np.random.default_rng(seed)
+    qp, _, _ = random_qp(rng, N, NG, shape)
+    first = hq.solve(qp, tol=TOL, warm_mu=0.1)
+    assume(first.status == SOLVED)
+    nxt = _shifted(qp) if shifted else _perturbed(qp, rng, 0.05)
+    ref = clarabel_solve(nxt)
+    assume(ref.status == "Solved")
+    r = hq.solve(nxt, tol=TOL, warm_start=1 if shifted else 2, warm_mu=0.1)
+    assert r.status == SOLVED, hq.status_message(r.status)
+    assert primal_error(nxt, r.sol, ref) <= PRIMAL_TOL
+    assert_kkt(nxt, r.sol, r.res["obj"])
+
+
+def test_warm_start_takes_fewer_iterations_on_slightly_moved_qps(hq: Harness) -> None:
+    """The point of keeping an iterate: over QPs whose data moved by 1 %, fewer iterations than from
+    the cold start, the same solutions."""
+    cold = warm = 0
+    for seed in range(30):
+        rng = np.random.default_rng(1000 + seed)
+        qp, _, _ = random_qp(rng, N, NG, Shape())
+        assert hq.solve(qp, tol=TOL, warm_mu=0.1).status == SOLVED
+        nxt = _perturbed(qp, rng, 0.01)
+        w = hq.solve(nxt, tol=TOL, warm_start=2)
+        c = hq.solve(nxt, tol=TOL)
+        assert w.status == SOLVED and c.status == SOLVED
+        assert np.max(np.abs(w.sol.u - c.sol.u)) <= 1e-5
+        cold, warm = cold + c.iter, warm + w.iter
+    assert warm < cold, (warm, cold)
+
+
+def test_a_kept_iterate_serves_one_solve_and_cold_solves_keep_none(hq: Harness) -> None:
+    """warm_start without a kept iterate, or a second time, is the cold start: the same iterates."""
+    qp, _, _ = random_qp(np.random.default_rng(7), N, NG, Shape())
+    cold = hq.solve(qp, tol=TOL)
+    again = hq.solve(qp, tol=TOL, warm_start=2)   # the cold solve kept nothing (warm_mu = 0)
+    assert again.iter == cold.iter and np.array_equal(again.sol.u, cold.sol.u)
+    hq.solve(qp, tol=TOL, warm_mu=0.1)
+    hq.solve(qp, tol=TOL, warm_start=2)           # uses it up
+    third = hq.solve(qp, tol=TOL, warm_start=2)
+    assert third.iter == cold.iter and np.array_equal(third.sol.u, cold.sol.u)
 
 
 @settings(QP_SETTINGS, max_examples=60)

@@ -32,6 +32,7 @@ hm_ocp_qp_sol *qp_harness_sol(void);
 void qp_harness_set_zero(void);
 int qp_harness_check(void);
 void qp_harness_arg(int max_iter, double tol, double tol_infeas, int stop_after, int polish);
+void qp_harness_warm(int warm_start, double warm_mu);
 int qp_harness_solve(void);
 int qp_harness_info(int *iter, int *polls, int *flags, double *res6, double *scaled3, double *mtk3);
 void qp_harness_res(double *res6);
@@ -112,6 +113,13 @@ void qp_harness_arg(int max_iter, double tol, double tol_infeas, int stop_after,
     g_stop_after = stop_after;
     g_arg.should_stop = stop_after >= 0 ? qp_harness_should_stop : NULL;
     g_arg.stop_ctx = &g_polls;
+}
+
+/* The warm start (after qp_harness_arg, which resets it): arg.warm_start and arg.warm_mu. */
+void qp_harness_warm(int warm_start, double warm_mu)
+{
+    g_arg.warm_start = warm_start;
+    g_arg.warm_mu = (hm_real)warm_mu;
 }
 
 int qp_harness_solve(void)
