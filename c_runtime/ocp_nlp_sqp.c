@@ -13,9 +13,9 @@
 #include "ocp_qp.h"
 #include "ocp_qp_ipm.h"
 
-/* Each RTI QP keeps its first iterate with mu <= this (scaled; 1 at the cold start) for the next
- * step's QP to start from (ocp_qp_ipm.c, warm start). */
-#define OCP_NLP_WARM_MU HM_R(0.1)
+/* Each RTI QP keeps its first iterate after the start with mu <= this (scaled; 1 at the cold start)
+ * for the next step's QP to start from (ocp_qp_ipm.c, warm start). */
+#define OCP_NLP_WARM_MU HM_R(0.2)
 
 static int ocp_nlp_clamp_humans(const hm_input *in)
 {
