@@ -1971,8 +1971,12 @@ HM_KERNEL int ocp_qp_ipm_rp_stuck(int iter, hm_real mu, hm_real mu0, hm_real rp,
     return iter > 1 && mu < HM_R(1e-2) * mu0 && rp * mu0 > HM_R(1e3) * rp0 * mu;
 }
 
-HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws,
-                             const hm_ocp_qp_ipm_arg *arg)
+/* ocp_qp_ipm_run's answer when a warm-started iteration stalls: the caller starts cold again */
+#define OCP_QP_IPM_COLD_AGAIN (-100)
+
+/* The interior-point iteration from the cold start, or (warm) from the kept iterate. */
+HM_FUNC int ocp_qp_ipm_run(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws,
+                           const hm_ocp_qp_ipm_arg *arg, int warm)
 {
     int status, bad = 0, ray = 0, fallback = 0, singular, stalling;
     ocp_qp_ipm_sums sm;
@@ -1982,9 +1986,6 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
     hm_real nd_seen = HM_R(0.0), pcost_seen = HM_R(0.0);
     int near_seen = 0;
 
-    /* the kept iterate serves one solve at most */
-    const int warm = arg->warm_start && ws->warm.ready;
-    ws->warm.ready = 0;
     ws->out.iter = 0;
     ws->out.unbounded = 0;
     ws->out.polished = 0;
@@ -2213,6 +2214,7 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
         }
     }
     if (fallback) {
+        if (warm) return OCP_QP_IPM_COLD_AGAIN;
         OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_FINISH, status = ocp_qp_ipm_fallback(qp, sol, ws, arg));
         return status;
     }
@@ -2224,5 +2226,28 @@ HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_
     }
     OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_FINISH,
                     status = ocp_qp_ipm_finish(qp, sol, ws, status, sm.bw, 1, arg->polish, arg->residuals, alpha));
+    return status;
+}
+
+HM_FUNC int ocp_qp_ipm_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ipm_ws *ws,
+                             const hm_ocp_qp_ipm_arg *arg)
+{
+    /* the kept iterate serves one solve at most */
+    const int warm = arg->warm_start && ws->warm.ready;
+    int status;
+    ws->warm.ready = 0;
+    status = ocp_qp_ipm_run(qp, sol, ws, arg, warm);
+    if (status == OCP_QP_IPM_COLD_AGAIN) {
+        /* A warm start that stalls (a stage whose data changed too much for the kept iterate) is
+         * cheaper to redo from the cold start than to hand to the fallback solver, which is several
+         * times slower per iteration: in the bench's crowds of 30 those hand-overs made the slowest
+         * 1 % of the steps. The iterations spent count against max_iter. */
+        hm_ocp_qp_ipm_arg cold = *arg;
+        const int done = ws->out.iter;
+        cold.max_iter = arg->max_iter - done;
+        ws->warm.ready = 0;
+        status = ocp_qp_ipm_run(qp, sol, ws, &cold, 0);
+        ws->out.iter += done;
+    }
     return status;
 }
