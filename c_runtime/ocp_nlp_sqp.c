@@ -54,7 +54,6 @@ HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
     int n, i;
     s->warm = 0;
     s->prepared = 0;
-    s->qp_last_step = 0;
     s->ipm_ws.warm.ready = 0;
     s->dyn_fresh = 0;
     for (n = 0; n < HM_N; n++)
@@ -813,9 +812,9 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
 {
     unsigned long long t_feedback;
     int qp_status, status, reason;
-    /* the plan moved on by one stage since the previous step's QP, if that step went without a stop */
-    const int shifted = s->warm && s->qp_last_step;
-    s->qp_last_step = 0;
+    /* the plan moved on by one stage since the last QP, whose kept iterate (if any: dropped after a
+     * stop, below) the QP starts from */
+    const int shifted = s->warm;
     ocp_nlp_start_clock(s, t_start);
     ocp_nlp_clear_output(out);
     s->qp_solves = 0;
@@ -879,8 +878,9 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
     }
     if (reason == HM_STOP_NONE || reason == HM_STOP_UNSAFE_PLAN) s->warm = 1;
     /* after a stop the next QP starts cold: after the braking retry (HM_STOP_UNSAFE_PLAN) its kept
-     * iterate is the retry's, whose linearisation the plan has left */
-    s->qp_last_step = reason == HM_STOP_NONE;
+     * iterate is the retry's, whose linearisation the plan has left; a stop before solving leaves one
+     * from an older step */
+    if (reason != HM_STOP_NONE) s->ipm_ws.warm.ready = 0;
     if (reason == HM_STOP_NONE) {
         ocp_nlp_report(s, in, out);
     } else {
@@ -932,9 +932,8 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
      * recurrence they end just below it, and at tol = 1e-9 the SQP stalled on that (stationarity
      * 3.5e-7 after 300 iterations, 30 people). */
     s->ipm_arg.recurrence = 0;
-    /* and all of them from the cold start */
+    /* and all of them from the cold start (keeping none, so the next RTI step starts cold too) */
     s->ipm_arg.warm_mu = HM_R(0.0);
-    s->qp_last_step = 0;
     for (k = 0; k < max_iter; k++) {
         ocp_nlp_linearize(s, in, k > 0);
         ocp_nlp_set_x0(s, in);

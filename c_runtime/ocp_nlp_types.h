@@ -16,8 +16,6 @@ typedef struct HM_NS(solver) {
     HM_NS(ocp_qp_sol) mult;
     int warm;        /* 1: x, u, mult hold a previous solution to shift */
     int prepared;    /* 1: qp holds the linearisation for the next feedback */
-    int qp_last_step; /* 1: the previous step solved its QP and went without a stop: the next QP, a
-                         stage on, starts from the iterate that one kept (ocp_nlp_qp_solve) */
     int n_active;    /* humans and obstacle rows of the current linearisation */
     int dyn_fresh;   /* 1: qp.A, qp.B are the dynamics' Jacobians at the iterate, which was just
                         simulated (no gaps): the next linearisation need not evaluate them again */

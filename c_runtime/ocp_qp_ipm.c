@@ -1879,7 +1879,7 @@ HM_FUNC void ocp_qp_ipm_warm_keep(hm_ocp_qp_ipm_ws *ws)
 
 HM_KERNEL hm_real ocp_qp_ipm_warm_floor(hm_real v)
 {
-    return v > OCP_QP_IPM_WARM_FLOOR ? v : OCP_QP_IPM_WARM_FLOOR;
+    return OCP_QP_IPM_MAX(v, OCP_QP_IPM_WARM_FLOOR);
 }
 
 /* Overwrite the cold start (ocp_qp_ipm_setup) with the kept iterate: stage n from kept stage

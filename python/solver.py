@@ -179,14 +179,14 @@ class Solver:
         rt = self.dtype
         self._x0 = _view(ffi, self._in.x0, (4,), rt)
         self._goal = _view(ffi, self._in.goal, (4,), rt)
-        self._h_now = _view(ffi, self._in.humans_now, (nh_alloc, 2), rt)
-        self._h_pred = _view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2), rt)
         self._obstacle = _view(ffi, self._in.obstacle, (2,), rt)
         self._nh, self._nodes = dims.nh, N + 1
         self._counts = (0, False)   # what _in.n_humans, _in.has_obstacle hold (ffi.new zeroes them)
         # the first k humans' rows, for every k, as views made once
-        self._h_now_first = [self._h_now[:k] for k in range(nh_alloc + 1)]
-        self._h_pred_first = [self._h_pred[:, :k] for k in range(nh_alloc + 1)]
+        h_now = _view(ffi, self._in.humans_now, (nh_alloc, 2), rt)
+        h_pred = _view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2), rt)
+        self._h_now_first = [h_now[:k] for k in range(nh_alloc + 1)]
+        self._h_pred_first = [h_pred[:, :k] for k in range(nh_alloc + 1)]
         self._out_buffer = ffi.buffer(self._out)
         self._out_dtype = record_dtype(ffi, f"{name}_output")
         self._param_fields = {f: t.type for f, t in ffi.typeof(f"{name}_params").fields}
