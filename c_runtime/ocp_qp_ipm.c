@@ -309,10 +309,14 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
             norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(acc));
         }
         sn->a_id = 0;
+        sn->ab_int = 0;
         if (n < HM_N) {
             const hm_real *A = qp->A[n];
+            const hm_real *B = qp->B[n];
             sn->a_id = A[0] == HM_R(1.0) && A[1] == HM_R(0.0) && A[2] == HM_R(0.0) && A[3] == HM_R(0.0)
                        && A[4] == HM_R(0.0) && A[5] == HM_R(1.0) && A[6] == HM_R(0.0) && A[7] == HM_R(0.0);
+            sn->ab_int = sn->a_id && A[10] == HM_R(1.0) && A[11] == HM_R(0.0) && A[14] == HM_R(0.0)
+                         && A[15] == HM_R(1.0) && B[2] == HM_R(0.0) && B[7] == HM_R(0.0);
         }
     }
     ws->m = m;

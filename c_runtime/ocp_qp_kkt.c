@@ -196,6 +196,112 @@ HM_FUNC int ocp_qp_kkt_factor_stage_posfree(const hm_ocp_qp *restrict qp, hm_ocp
     return 0;
 }
 
+/* Stage 0 < n < HM_N of the factorisation when, beyond A_n = [e_0 e_1 a_2 a_3], rows 2 and 3 of
+ * [A_n B_n] are those of two integrators (the robot's heading and speed: theta += b21 omega,
+ * v += b30 a; sn->ab_int): a_2 = (a02, a12, 1, 0), a_3 = (a03, a13, 0, 1) and B = [b00 b01; b10 b11;
+ * 0 b21; b30 0]. The path above with the products by these zeros and ones left out, every sum in the
+ * same order: the same numbers (up to the sign of a zero; P is stored mirrored, so its columns are
+ * its rows). Written so that the compiler runs the products with P as column operations in vector
+ * lanes; the scalar code it made of the same sums written entry by entry was slower although it
+ * did less arithmetic (docs/benchmarks.md). */
+HM_FUNC int ocp_qp_kkt_factor_stage_integrators(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn,
+                                                const hm_ocp_qp_ipm_stage *restrict sn1, int n)
+{
+    const hm_real *restrict P = sn1->P;
+    const hm_real *restrict A = qp->A[n];
+    const hm_real *restrict B = qp->B[n];
+    const hm_real *restrict Q = sn->Q;
+    const hm_real *restrict S = sn->S;
+    const hm_real *restrict Hd = sn->Hd;
+    const hm_real *restrict r = sn->ry;
+    const hm_real a02 = A[8], a12 = A[9], a03 = A[12], a13 = A[13];
+    const hm_real b00 = B[0], b10 = B[1], b30 = B[3];
+    const hm_real b01 = B[4], b11 = B[5], b21 = B[6];
+    /* P B, P a_2, P a_3 and P ry, by columns */
+    hm_real f0[HM_NX], f1[HM_NX], g2[HM_NX], g3[HM_NX];
+    hm_real h00, h10, h11, x00, x10, x20, x30, x01, x11, x21, x31;
+    hm_real id0, l10, id1, k0[4], k1[4], c0[4], c1[4], *restrict Pn = sn->P;
+    hm_real q00, q10, q20, q30, q11, q21, q31, q22, q32, q33;
+    int i;
+    for (i = 0; i < HM_NX; i++) {
+        f0[i] = P[i] * b00 + P[4 + i] * b10 + P[12 + i] * b30;
+        f1[i] = P[i] * b01 + P[4 + i] * b11 + P[8 + i] * b21;
+        g2[i] = P[i] * a02 + P[4 + i] * a12 + P[8 + i];
+        g3[i] = P[i] * a03 + P[4 + i] * a13 + P[12 + i];
+    }
+    /* the input block */
+    h00 = sn->R[0] + Hd[0] + (b00 * f0[0] + b10 * f0[1] + b30 * f0[3]);
+    h10 = sn->R[1] + (b01 * f0[0] + b11 * f0[1] + b21 * f0[2]);
+    h11 = sn->R[3] + Hd[1] + (b01 * f1[0] + b11 * f1[1] + b21 * f1[2]);
+    /* the state-input block (S + B' P A)', column j for u_j */
+    x00 = S[0] + f0[0];
+    x10 = S[2] + f0[1];
+    x20 = S[4] + (a02 * f0[0] + a12 * f0[1] + f0[2]);
+    x30 = S[6] + (a03 * f0[0] + a13 * f0[1] + f0[3]);
+    x01 = S[1] + f1[0];
+    x11 = S[3] + f1[1];
+    x21 = S[5] + (a02 * f1[0] + a12 * f1[1] + f1[2]);
+    x31 = S[7] + (a03 * f1[0] + a13 * f1[1] + f1[3]);
+    for (i = 0; i < HM_NX; i++) sn->Pry[i] = P[i] * r[0] + P[4 + i] * r[1] + P[8 + i] * r[2] + P[12 + i] * r[3];
+    if (ocp_qp_kkt_input_ldl(sn, h00, h10, h11)) return HM_QP_NUMERICAL;
+    id0 = sn->Ld[0];
+    l10 = sn->Ld[1];
+    id1 = sn->Ld[2];
+    k0[0] = x00;
+    k0[1] = x10;
+    k0[2] = x20;
+    k0[3] = x30;
+    k1[0] = x01 - l10 * x00;
+    k1[1] = x11 - l10 * x10;
+    k1[2] = x21 - l10 * x20;
+    k1[3] = x31 - l10 * x30;
+    c0[0] = k0[0] * id0;
+    c0[1] = k0[1] * id0;
+    c0[2] = k0[2] * id0;
+    c0[3] = k0[3] * id0;
+    c1[0] = k1[0] * id1;
+    c1[1] = k1[1] * id1;
+    c1[2] = k1[2] * id1;
+    c1[3] = k1[3] * id1;
+    sn->Kx[0] = k0[0];
+    sn->Kx[1] = k0[1];
+    sn->Kx[2] = k0[2];
+    sn->Kx[3] = k0[3];
+    sn->Kx[4] = k1[0];
+    sn->Kx[5] = k1[1];
+    sn->Kx[6] = k1[2];
+    sn->Kx[7] = k1[3];
+    /* Q + A' P A + the inequalities' diagonal and (px, py) block, minus the Schur terms */
+    q00 = Q[0] + P[0] + Hd[2] + sn->Hpp[0] - c0[0] * k0[0] - c1[0] * k1[0];
+    q10 = Q[1] + P[1] + sn->Hpp[1] - c0[1] * k0[0] - c1[1] * k1[0];
+    q11 = Q[5] + P[5] + Hd[3] + sn->Hpp[2] - c0[1] * k0[1] - c1[1] * k1[1];
+    q20 = Q[2] + g2[0] - c0[2] * k0[0] - c1[2] * k1[0];
+    q21 = Q[6] + g2[1] - c0[2] * k0[1] - c1[2] * k1[1];
+    q30 = Q[3] + g3[0] - c0[3] * k0[0] - c1[3] * k1[0];
+    q31 = Q[7] + g3[1] - c0[3] * k0[1] - c1[3] * k1[1];
+    q22 = Q[10] + Hd[4] + (a02 * g2[0] + a12 * g2[1] + g2[2]) - c0[2] * k0[2] - c1[2] * k1[2];
+    q32 = Q[11] + (a03 * g2[0] + a13 * g2[1] + g2[3]) - c0[3] * k0[2] - c1[3] * k1[2];
+    q33 = Q[15] + Hd[5] + (a03 * g3[0] + a13 * g3[1] + g3[3]) - c0[3] * k0[3] - c1[3] * k1[3];
+    Pn[0] = q00;
+    Pn[1] = q10;
+    Pn[2] = q20;
+    Pn[3] = q30;
+    Pn[4] = q10;
+    Pn[5] = q11;
+    Pn[6] = q21;
+    Pn[7] = q31;
+    Pn[8] = q20;
+    Pn[9] = q21;
+    Pn[10] = q22;
+    Pn[11] = q32;
+    Pn[12] = q30;
+    Pn[13] = q31;
+    Pn[14] = q32;
+    Pn[15] = q33;
+    ocp_qp_kkt_closed_loop(qp, sn, n);
+    return 0;
+}
+
 HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn,
                                     const hm_ocp_qp_ipm_stage *restrict sn1, int n)
 {
@@ -203,7 +309,10 @@ HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_
     hm_real h00 = HM_R(0.0), h10 = HM_R(0.0), h11 = HM_R(0.0);
     int i, j;
 
-    if (n > 0 && n < HM_N && sn->a_id) return ocp_qp_kkt_factor_stage_posfree(qp, sn, sn1, n);
+    if (n > 0 && n < HM_N && sn->a_id) {
+        if (sn->ab_int) return ocp_qp_kkt_factor_stage_integrators(qp, sn, sn1, n);
+        return ocp_qp_kkt_factor_stage_posfree(qp, sn, sn1, n);
+    }
     if (n < HM_N) {
         const hm_real *restrict P = sn1->P;
         const hm_real *restrict A = qp->A[n];

@@ -154,7 +154,7 @@ int qp_harness_solve(void);
 int qp_harness_info(int *iter, int *polls, int *flags, double *res6, double *scaled3, double *mtk3);
 void qp_harness_res(double *res6);
 const char *qp_harness_status_message(int status);
-int qp_harness_kkt_map(int *m, int *off, int *nb, int *nr, int *ns, double *cost_scale);
+int qp_harness_kkt_map(int *m, int *off, int *nb, int *nr, int *ns, int *kernel, double *cost_scale);
 int qp_harness_kkt_solve(const {real} *w, const {real} *rhs, {real} *sol);
 """
 
@@ -265,12 +265,13 @@ class Harness:
         return str(self.ffi.string(self.lib.qp_harness_status_message(status)).decode())
 
     def kkt_map(self, qp: QP) -> tuple[int, float, dict[str, list[int]]]:
-        """(number of packed inequality rows, cost scale, per-stage offsets and counts)."""
+        """(number of packed inequality rows, cost scale, per-stage offsets and counts, and the
+        Riccati kernel of each stage: 0 general, 1 position-free, 2 integrators)."""
         self.load(qp)
-        arrs = {k: self.ffi.new("int[]", self.horizon + 1) for k in ("off", "nb", "nr", "ns")}
+        arrs = {k: self.ffi.new("int[]", self.horizon + 1) for k in ("off", "nb", "nr", "ns", "kernel")}
         m = self.ffi.new("int *")
         cs = self.ffi.new("double *")
-        st = self.lib.qp_harness_kkt_map(m, arrs["off"], arrs["nb"], arrs["nr"], arrs["ns"], cs)
+        st = self.lib.qp_harness_kkt_map(m, arrs["off"], arrs["nb"], arrs["nr"], arrs["ns"], arrs["kernel"], cs)
         assert st == 0
         return int(m[0]), float(cs[0]), {k: list(v) for k, v in arrs.items()}
 
@@ -569,7 +570,10 @@ class Shape:
     l1_only: bool = False  # soft rows with Zl = 0
     duplicate_rows: bool = False
     scale: float = 1.0  # magnitude of the linear cost terms (pulls the optimum onto bounds)
-    position_free_dynamics: bool = False  # A = [e_0 e_1 * *] on most stages, as the robot's (the solver's fast path)
+    # "general"; "position_free": A = [e_0 e_1 * *] on most stages; "integrators": that, and on most of
+    # those stages rows 2 and 3 of [A B] those of two integrators (the robot's heading and speed). Each
+    # is a kernel of the Riccati recursion (ocp_qp_kkt.c), and all that apply meet in one QP.
+    dynamics: str = "general"
 
 
 def empty_qp(N: int, NG: int) -> QP:
@@ -593,13 +597,22 @@ def random_qp(rng: np.random.Generator, N: int, NG: int, shape: Shape = Shape())
     (qp, x_ref, u_ref)); soft rows are placed anywhere, often violated at the optimum."""
     qp = empty_qp(N, NG)
     qp.A[:] = np.eye(NX) + 0.3 * rng.standard_normal((N, NX, NX))
-    if shape.position_free_dynamics:
+    qp.B[:] = 0.5 * rng.standard_normal((N, NX, NU))
+    if shape.dynamics in ("position_free", "integrators"):
         # the position does not enter the dynamics (columns 0 and 1 unit vectors), except on a few
-        # stages, so that both kernels of the Riccati recursion meet in one QP
+        # stages
         plain = rng.random(N) < 0.8
         qp.A[plain, :, 0] = np.eye(NX)[0]
         qp.A[plain, :, 1] = np.eye(NX)[1]
-    qp.B[:] = 0.5 * rng.standard_normal((N, NX, NU))
+        if shape.dynamics == "integrators":
+            # theta += B[2, 1] omega and v += B[3, 0] a, as the robot's
+            integ = plain & (rng.random(N) < 0.8)
+            qp.A[integ, 2, :] = np.eye(NX)[2]
+            qp.A[integ, 3, :] = np.eye(NX)[3]
+            qp.B[integ, 2, 0] = 0.0
+            qp.B[integ, 3, 1] = 0.0
+    elif shape.dynamics != "general":
+        raise ValueError(f"unknown dynamics {shape.dynamics!r}")
     qp.b[:] = 0.1 * rng.standard_normal((N, NX))
     qp.x0[:] = rng.standard_normal(NX)
     qp.lbu[:] = -0.5 - rng.random((N, NU))

@@ -91,7 +91,7 @@ shapes = st.builds(
     l1_only=st.booleans(),
     duplicate_rows=st.booleans(),
     scale=st.sampled_from([0.1, 1.0, 10.0]),
-    position_free_dynamics=st.booleans(),
+    dynamics=st.sampled_from(["general", "position_free", "integrators"]),
 )
 seeds = st.integers(min_value=0, max_value=2**32 - 1)
 
@@ -131,7 +131,14 @@ def test_riccati_solve_equals_dense_solve_of_the_newton_system(hq: Harness, seed
     numpy) to a backward error of rounding size, for row weights spread as late in a solve."""
     rng = np.random.default_rng(seed)
     qp, _, _ = random_qp(rng, N, NG, shape)
-    m, cost_scale, _ = hq.kkt_map(qp)
+    m, cost_scale, stages = hq.kkt_map(qp)
+    # the kernel the data's structure calls for: so every kernel of the recursion is under test
+    eye = np.eye(NX)
+    pos_free = [np.array_equal(qp.A[n][:, :2], eye[:, :2]) for n in range(N)]
+    integ = [pos_free[n] and np.array_equal(qp.A[n][2:], eye[2:]) and qp.B[n][2, 0] == 0 and qp.B[n][3, 1] == 0
+             for n in range(N)]
+    want = [2 if i else 1 if p else 0 for p, i in zip(pos_free, integ, strict=True)]
+    assert stages["kernel"] == [0, *want[1:], 0]  # stages 0 and N have kernels of their own
     cf = conic_form(qp)
     assert m == cf.Ain.shape[0]  # the C solver packs the same rows
     w = 10.0 ** rng.uniform(-log_w, log_w, m)

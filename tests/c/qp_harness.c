@@ -37,7 +37,7 @@ int qp_harness_solve(void);
 int qp_harness_info(int *iter, int *polls, int *flags, double *res6, double *scaled3, double *mtk3);
 void qp_harness_res(double *res6);
 const char *qp_harness_status_message(int status);
-int qp_harness_kkt_map(int *m, int *off, int *nb, int *nr, int *ns, double *cost_scale);
+int qp_harness_kkt_map(int *m, int *off, int *nb, int *nr, int *ns, int *kernel, double *cost_scale);
 int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol);
 
 static hm_ocp_qp g_qp;
@@ -193,7 +193,9 @@ static void qp_harness_row_map(int n, int *kind, int *fam)
 /* Builds the row map of the current problem; arrays have HM_N + 1 entries (packed offsets and
  * counts: bound sides, general rows, soft rows). Also reports the cost scale the Newton system is
  * built with. Returns the setup status (HM_QP_INFEASIBLE for crossing bounds). */
-int qp_harness_kkt_map(int *m, int *off, int *nb, int *nr, int *ns, double *cost_scale)
+/* Per stage: the offset and counts of its packed inequality rows, and the kernel of the Riccati
+ * recursion its dynamics take (ocp_qp_kkt.c: 0 general, 1 position-free, 2 integrators). */
+int qp_harness_kkt_map(int *m, int *off, int *nb, int *nr, int *ns, int *kernel, double *cost_scale)
 {
     int bad = 0, n, k, total = 0;
     const int status = ocp_qp_ipm_setup(&g_qp, &g_ws, &bad);
@@ -207,6 +209,7 @@ int qp_harness_kkt_map(int *m, int *off, int *nb, int *nr, int *ns, double *cost
         nb[n] = cnt;
         nr[n] = sn->ns + sn->nh;
         ns[n] = sn->ns;
+        kernel[n] = n > 0 && n < HM_N && sn->a_id ? 1 + sn->ab_int : 0;   /* as ocp_qp_kkt_factor_stage */
         total += cnt + sn->ns + sn->nh + sn->ns;
     }
     *m = total;
