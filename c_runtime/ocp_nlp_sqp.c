@@ -281,9 +281,14 @@ static void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
          * gradient, Gauss-Newton Hessian on the (px, py) block. */
         for (j = 0; j < nh; j++) {
             hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP], hess_exact[HM_NP * HM_NP];
-            const hm_real *hess = exact ? hess_exact : hess_gn;
-            hm_model_cost_collision(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn,
-                                    hess_exact);
+            const hm_real *hess = hess_gn;
+            if (exact) {
+                hm_model_cost_collision(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn,
+                                        hess_exact);
+                hess = hess_exact;
+            } else {
+                hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
+            }
             cost += f;
             q[0] += grad[0];
             q[1] += grad[1];
@@ -557,8 +562,8 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
         }
         merit += l;
         for (j = 0; j < nh; j++) {
-            hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP], hess[HM_NP * HM_NP];
-            hm_model_cost_collision(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn, hess);
+            hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP];
+            hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
             merit += f;
         }
         if (n == 0) continue;

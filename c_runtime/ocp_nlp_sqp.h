@@ -14,8 +14,8 @@
  * true constraint is guarded by the safety monitor.
  *
  * Model functions are supplied by the including translation unit as the macros hm_model_dynamics,
- * hm_model_cost_stage, hm_model_cost_terminal, hm_model_cost_collision and
- * hm_model_distance_constraint (the generated CasADi wrappers).
+ * hm_model_dynamics_hessian, hm_model_cost_stage, hm_model_cost_terminal, hm_model_cost_collision,
+ * hm_model_cost_collision_gn and hm_model_distance_constraint (the generated CasADi wrappers).
  */
 #ifndef OCP_NLP_SQP_H
 #define OCP_NLP_SQP_H

@@ -215,6 +215,23 @@ class OcpModel:
             )
         )
 
+        # The same without the exact Hessian, for the Gauss-Newton steps (every RTI step, for every
+        # human at every node): CasADi evaluates every output, and the exact Hessian's terms were a
+        # seventh of the preparation (docs/benchmarks.md).
+        functions.append(
+            self._make(
+                "cost_collision_gn",
+                "collision cost f(d(p, h)) of one human at predicted position h, its exact gradient and "
+                "its Gauss-Newton Hessian f''(d) grad d grad d' (cost_collision without the exact Hessian)",
+                [("p", p), ("h", c), ("q", q), ("d_th", d_th), ("kappa", kappa)],
+                [
+                    ("f", f_val),
+                    ("grad_p", f_d * grad_d),
+                    ("hess_gn_p", f_dd * (grad_d @ grad_d.T)),
+                ],
+            )
+        )
+
         # Distance rows: d(p, c) - d_min >= 0 for a human's current position (d_h) and the
         # closest obstacle (d_s).
         functions.append(

@@ -75,7 +75,7 @@ def test_c_functions_equal_casadis_evaluation(paper: humanmpc.Solver, casadi_mod
         c_fn = getattr(paper.model, mf.name)
         for _ in range(POINTS):
             args = [rng.uniform(-3, 3, size=(p.rows, p.cols)) for p in mf.inputs]
-            if mf.name == "cost_collision":
+            if mf.name in ("cost_collision", "cost_collision_gn"):
                 args[4] = np.array([[rng.uniform(0.1, 20)]])  # kappa > 0
             expected = mf.function(*args)
             got = c_fn(*[a.reshape(-1) if a.shape[1] == 1 else a for a in args])
