@@ -1014,6 +1014,71 @@ HM_FUNC void ocp_qp_ipm_stage_measures(const hm_ocp_qp *restrict qp, hm_ocp_qp_i
     sm->exact = 1;
 }
 
+/* ocp_qp_ipm_stage_measures at the starting point, where v = 0 and y = 0 (the cold start and the warm
+ * start both begin there, and pass A's step is zero): every product with v or y vanishes, so the
+ * residuals are r_y = b_E and r_v = q + A_I' z (the inequalities' multipliers alone), the norms of P v
+ * and A_E v are zero, and so are q' v and v' P v. The same numbers as the general sweep (up to the
+ * sign of a zero), without its products: the first iteration of every solve takes them. */
+HM_FUNC void ocp_qp_ipm_stage_measures_start(hm_ocp_qp_ipm_ws *restrict ws, ocp_qp_ipm_sums *restrict sm)
+{
+    hm_real atw_n = HM_R(0.0), rd_eq = HM_R(0.0), rp_eq = HM_R(0.0);
+    hm_real rd_v[HM_QP_NUX], atw_v[HM_QP_NUX], rpe_v[HM_NX];
+    const hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
+    const hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
+    int n, i, j, k;
+
+    for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = atw_v[i] = HM_R(0.0);
+    for (i = 0; i < HM_NX; i++) rpe_v[i] = HM_R(0.0);
+    for (n = 0; n <= HM_N; n++) {
+        hm_ocp_qp_ipm_stage *restrict sn = &ws->u.f.st[n];
+        hm_real atw[HM_QP_NUX];
+        /* dynamics n -> n + 1: the residual of x_{n+1} - A x_n - B u_n = b_n is -b_n */
+        if (n < HM_N) {
+            for (i = 0; i < HM_NX; i++) {
+                sn->ry[i] = sn->beq[i];
+                rpe_v[i] = OCP_QP_IPM_MAX(rpe_v[i], OCP_QP_IPM_ABS(sn->beq[i]));
+            }
+        }
+        /* A' w: the rows and the bound pairs */
+        for (i = 0; i < HM_QP_NUX; i++) atw[i] = HM_R(0.0);
+        if (n > 0) {
+            for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
+                atw[HM_NU] -= sr->sd0[j] * sr->sz[j];
+                atw[HM_NU + 1] -= sr->sd1[j] * sr->sz[j];
+            }
+            for (j = 0; j < sn->nh2; j++) {
+                atw[HM_NU] -= sn->hd0[j] * sn->hz[j];
+                atw[HM_NU + 1] -= sn->hd1[j] * sn->hz[j];
+            }
+        }
+        for (k = 0; k < bd->nbp; k++)
+            atw[bd->bc[k]] += bd->sg[k][0][n] * bd->z[k][0][n] + bd->sg[k][1][n] * bd->z[k][1][n];
+        /* stationarity of (u, x): r = q + A' w */
+        for (i = 0; i < HM_QP_NUX; i++) {
+            const hm_real ri = sn->q[i] + atw[i];
+            sn->ha[i] += ri - sn->rv[i];
+            sn->rv[i] = ri;
+            atw_v[i] = OCP_QP_IPM_MAX(atw_v[i], OCP_QP_IPM_ABS(atw[i]));
+            rd_v[i] = OCP_QP_IPM_MAX(rd_v[i], OCP_QP_IPM_ABS(ri));
+        }
+    }
+    for (i = 0; i < HM_QP_NUX; i++) {
+        atw_n = OCP_QP_IPM_MAX(atw_n, atw_v[i]);
+        rd_eq = OCP_QP_IPM_MAX(rd_eq, rd_v[i]);
+    }
+    for (i = 0; i < HM_NX; i++) rp_eq = OCP_QP_IPM_MAX(rp_eq, rpe_v[i]);
+    sm->qv = sm->qv_in;
+    sm->vPv = sm->vPv_in;
+    sm->atw = atw_n;
+    sm->pv = HM_R(0.0);
+    sm->av_eq = HM_R(0.0);
+    sm->rp_eq = rp_eq;
+    sm->rd_eq = rd_eq;
+    sm->rp = OCP_QP_IPM_MAX(sm->rp_in, rp_eq);
+    sm->rd = OCP_QP_IPM_MAX(sm->rd_in, rd_eq);
+    sm->exact = 1;
+}
+
 /* The norms over the inequalities of the iterate left by pass A (see ocp_qp_ipm_sums). */
 HM_FUNC void ocp_qp_ipm_row_measures(const hm_ocp_qp_ipm_ws *restrict ws, ocp_qp_ipm_sums *restrict sm)
 {
@@ -2017,7 +2082,9 @@ HM_FUNC int ocp_qp_ipm_run(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ip
         /* the stage measures in the first iteration, and where the certificate test needs A' w:
          * b' w < 0 and the soft slacks' part of A' w (the inequality measures) small enough */
         if (ws->out.iter > 0 && sm.bw < HM_R(0.0)) ocp_qp_ipm_row_measures(ws, &sm);
-        if (!arg->recurrence || ws->out.iter == 0 || (sm.bw < HM_R(0.0) && sm.atw_s <= arg->tol_infeas * -sm.bw))
+        if (ws->out.iter == 0)
+            OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_A, ocp_qp_ipm_stage_measures_start(ws, &sm));
+        else if (!arg->recurrence || (sm.bw < HM_R(0.0) && sm.atw_s <= arg->tol_infeas * -sm.bw))
             OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_A, ocp_qp_ipm_stage_measures(qp, ws, &sm));
         mu = sm.tz / mdeg;
         if (arg->warm_mu > HM_R(0.0) && !ws->warm.ready && ws->out.iter > 0 && mu <= arg->warm_mu)
