@@ -226,16 +226,22 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
             if (lp) norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(lb));
             if (up) norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(ub));
             m += lp + up;
-            for (l = 0; l < 2; l++) {
-                const int present = bd->sg[k][l][n] != HM_R(0.0);
-                const hm_real t = present ? OCP_QP_IPM_MAX(bd->b[k][l][n], HM_R(1.0)) : HM_R(1.0);
-                bd->t[k][l][n] = t;
-                bd->z[k][l][n] = present ? HM_R(1.0) / t : HM_R(1.0);
-                bd->dt[k][l][n] = HM_R(0.0);
-                bd->dz[k][l][n] = HM_R(0.0);
-            }
-            bd->v[k][n] = bd->dv[k][n] = HM_R(0.0);
         }
+        /* the starting point of the slot's sides: a loop of its own, without the branches of the
+         * bounds' lookup, so that its divisions run in vector lanes (an absent side has b = 1) */
+        for (l = 0; l < 2; l++) {
+            const hm_real *restrict b = bd->b[k][l];
+            hm_real *restrict t = bd->t[k][l];
+            hm_real *restrict z = bd->z[k][l];
+            hm_real *restrict dt = bd->dt[k][l];
+            hm_real *restrict dz = bd->dz[k][l];
+            for (n = 0; n < HM_QP_NNP; n++) {
+                t[n] = OCP_QP_IPM_MAX(b[n], HM_R(1.0));
+                z[n] = HM_R(1.0) / t[n];
+                dt[n] = dz[n] = HM_R(0.0);
+            }
+        }
+        for (n = 0; n < HM_QP_NNP; n++) bd->v[k][n] = bd->dv[k][n] = HM_R(0.0);
     }
 
     for (n = 0; n <= HM_N; n++) {
@@ -359,9 +365,7 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
             sr->szl[row] *= c;
             sr->sZl[row] *= c;
             sr->ss[row] = s;
-            sr->st[row] = t;
-            sr->sz[row] = HM_R(1.0) / t;
-            sr->szs[row] = HM_R(1.0) / s;
+            sr->st[row] = t;   /* z = 1 / t and zs = 1 / s below, over the whole list */
         }
         if (sn->ns & 1) ocp_qp_ipm_rows_absent(sr, sn->soff + sn->ns);   /* the stage's padding row */
         for (j = sn->soff; j < sn->soff + sn->ns; j++) sr->sds[j] = sr->sdt[j] = sr->sdz[j] = sr->sdzs[j] = HM_R(0.0);
@@ -378,6 +382,15 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
             sn->ht[j] = sn->hz[j] = HM_R(1.0);
         }
         for (j = 0; j < sn->nh2; j++) sn->hdt[j] = sn->hdz[j] = HM_R(0.0);
+    }
+    /* the rows' starting multipliers, in vector lanes (a stage's padding row: 1 / 1) */
+    {
+        const hm_real *restrict ss = sr->ss, *restrict st = sr->st;
+        hm_real *restrict sz = sr->sz, *restrict szs = sr->szs;
+        for (j = 0; j < sr->nr; j++) {
+            sz[j] = HM_R(1.0) / st[j];
+            szs[j] = HM_R(1.0) / ss[j];
+        }
     }
     /* the list's padding rows up to the last block of the passes */
     for (j = sr->nr; j < ocp_qp_ipm_rows_blocks(sr); j++) ocp_qp_ipm_rows_absent(sr, j);
