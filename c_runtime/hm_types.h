@@ -143,8 +143,8 @@ typedef struct HM_NS(ocp_qp_ipm_stage) {
     int soff;                         /* soft row j of the stage is row soff + j of ocp_qp_ipm_rows */
     int ns2, nh2;                     /* the same rounded up to even (rows go in pairs) */
     int a_id;                         /* 1: the first two columns of A_n are e_0, e_1 */
-    int ab_int;                       /* 1 (with a_id): rows 2 and 3 of [A_n B_n] are two integrators'
-                                         (ocp_qp_kkt.c: ocp_qp_kkt_factor_stage_integrators) */
+    int ab_int;                       /* 1: a_id, and rows 2 and 3 of [A_n B_n] are two integrators' (the
+                                         robot's; ocp_qp_kkt.c: ocp_qp_kkt_factor_stage_integrators) */
     unsigned char hrow[(HM_NG + 1) / 2 * 2];   /* QP row of hard row j */
     /* cost times the cost scale (stage 0: x_0 terms folded into q), dynamics offset (stage 0:
      * b_0 + A_0 x_0); column-major like ocp_qp */

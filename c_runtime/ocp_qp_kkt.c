@@ -81,129 +81,16 @@ HM_KERNEL void ocp_qp_kkt_closed_loop(const hm_ocp_qp *restrict qp, hm_ocp_qp_ip
     }
 }
 
-/* Stage 0 < n < HM_N of the factorisation when A_n = [e_0 e_1 a_2 a_3] (the robot's dynamics: the
- * position enters no other state's update), written out: every matrix entry a scalar, the
- * symmetric ones once. Same results as the general path up to the order of the sums. */
-HM_FUNC int ocp_qp_kkt_factor_stage_posfree(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn,
-                                            const hm_ocp_qp_ipm_stage *restrict sn1, int n)
-{
-    const hm_real *restrict P = sn1->P;
-    const hm_real *restrict A = qp->A[n];
-    const hm_real *restrict B = qp->B[n];
-    const hm_real *restrict Q = sn->Q;
-    const hm_real *restrict S = sn->S;
-    const hm_real *restrict Hd = sn->Hd;
-    const hm_real p00 = P[0], p10 = P[1], p20 = P[2], p30 = P[3];
-    const hm_real p11 = P[5], p21 = P[6], p31 = P[7], p22 = P[10], p32 = P[11], p33 = P[15];
-    const hm_real a02 = A[8], a12 = A[9], a22 = A[10], a32 = A[11];
-    const hm_real a03 = A[12], a13 = A[13], a23 = A[14], a33 = A[15];
-    const hm_real b00 = B[0], b10 = B[1], b20 = B[2], b30 = B[3];
-    const hm_real b01 = B[4], b11 = B[5], b21 = B[6], b31 = B[7];
-    /* P B, P a_2, P a_3 */
-    const hm_real f00 = p00 * b00 + p10 * b10 + p20 * b20 + p30 * b30;
-    const hm_real f10 = p10 * b00 + p11 * b10 + p21 * b20 + p31 * b30;
-    const hm_real f20 = p20 * b00 + p21 * b10 + p22 * b20 + p32 * b30;
-    const hm_real f30 = p30 * b00 + p31 * b10 + p32 * b20 + p33 * b30;
-    const hm_real f01 = p00 * b01 + p10 * b11 + p20 * b21 + p30 * b31;
-    const hm_real f11 = p10 * b01 + p11 * b11 + p21 * b21 + p31 * b31;
-    const hm_real f21 = p20 * b01 + p21 * b11 + p22 * b21 + p32 * b31;
-    const hm_real f31 = p30 * b01 + p31 * b11 + p32 * b21 + p33 * b31;
-    const hm_real g02 = p00 * a02 + p10 * a12 + p20 * a22 + p30 * a32;
-    const hm_real g12 = p10 * a02 + p11 * a12 + p21 * a22 + p31 * a32;
-    const hm_real g22 = p20 * a02 + p21 * a12 + p22 * a22 + p32 * a32;
-    const hm_real g32 = p30 * a02 + p31 * a12 + p32 * a22 + p33 * a32;
-    const hm_real g03 = p00 * a03 + p10 * a13 + p20 * a23 + p30 * a33;
-    const hm_real g13 = p10 * a03 + p11 * a13 + p21 * a23 + p31 * a33;
-    const hm_real g23 = p20 * a03 + p21 * a13 + p22 * a23 + p32 * a33;
-    const hm_real g33 = p30 * a03 + p31 * a13 + p32 * a23 + p33 * a33;
-    /* the input block and its LDL' */
-    const hm_real h00 = sn->R[0] + Hd[0] + (b00 * f00 + b10 * f10 + b20 * f20 + b30 * f30);
-    const hm_real h10 = sn->R[1] + (b01 * f00 + b11 * f10 + b21 * f20 + b31 * f30);
-    const hm_real h11 = sn->R[3] + Hd[1] + (b01 * f01 + b11 * f11 + b21 * f21 + b31 * f31);
-    /* the state-input block (S + B' P A)', column j for u_j */
-    const hm_real x00 = S[0] + f00, x10 = S[2] + f10;
-    const hm_real x20 = S[4] + (a02 * f00 + a12 * f10 + a22 * f20 + a32 * f30);
-    const hm_real x30 = S[6] + (a03 * f00 + a13 * f10 + a23 * f20 + a33 * f30);
-    const hm_real x01 = S[1] + f01, x11 = S[3] + f11;
-    const hm_real x21 = S[5] + (a02 * f01 + a12 * f11 + a22 * f21 + a32 * f31);
-    const hm_real x31 = S[7] + (a03 * f01 + a13 * f11 + a23 * f21 + a33 * f31);
-    hm_real id0, l10, id1, k0[4], k1[4], c0[4], c1[4], *restrict Pn = sn->P;
-    hm_real q00, q10, q20, q30, q11, q21, q31, q22, q32, q33;
-    {
-        const hm_real *restrict r = sn->ry;
-        hm_real *restrict pr = sn->Pry;
-        pr[0] = p00 * r[0] + p10 * r[1] + p20 * r[2] + p30 * r[3];
-        pr[1] = p10 * r[0] + p11 * r[1] + p21 * r[2] + p31 * r[3];
-        pr[2] = p20 * r[0] + p21 * r[1] + p22 * r[2] + p32 * r[3];
-        pr[3] = p30 * r[0] + p31 * r[1] + p32 * r[2] + p33 * r[3];
-    }
-    if (ocp_qp_kkt_input_ldl(sn, h00, h10, h11)) return HM_QP_NUMERICAL;
-    id0 = sn->Ld[0];
-    l10 = sn->Ld[1];
-    id1 = sn->Ld[2];
-    k0[0] = x00;
-    k0[1] = x10;
-    k0[2] = x20;
-    k0[3] = x30;
-    k1[0] = x01 - l10 * x00;
-    k1[1] = x11 - l10 * x10;
-    k1[2] = x21 - l10 * x20;
-    k1[3] = x31 - l10 * x30;
-    c0[0] = k0[0] * id0;
-    c0[1] = k0[1] * id0;
-    c0[2] = k0[2] * id0;
-    c0[3] = k0[3] * id0;
-    c1[0] = k1[0] * id1;
-    c1[1] = k1[1] * id1;
-    c1[2] = k1[2] * id1;
-    c1[3] = k1[3] * id1;
-    sn->Kx[0] = k0[0];
-    sn->Kx[1] = k0[1];
-    sn->Kx[2] = k0[2];
-    sn->Kx[3] = k0[3];
-    sn->Kx[4] = k1[0];
-    sn->Kx[5] = k1[1];
-    sn->Kx[6] = k1[2];
-    sn->Kx[7] = k1[3];
-    /* Q + A' P A + the inequalities' diagonal and (px, py) block, minus the Schur terms */
-    q00 = Q[0] + p00 + Hd[2] + sn->Hpp[0] - c0[0] * k0[0] - c1[0] * k1[0];
-    q10 = Q[1] + p10 + sn->Hpp[1] - c0[1] * k0[0] - c1[1] * k1[0];
-    q11 = Q[5] + p11 + Hd[3] + sn->Hpp[2] - c0[1] * k0[1] - c1[1] * k1[1];
-    q20 = Q[2] + g02 - c0[2] * k0[0] - c1[2] * k1[0];
-    q21 = Q[6] + g12 - c0[2] * k0[1] - c1[2] * k1[1];
-    q30 = Q[3] + g03 - c0[3] * k0[0] - c1[3] * k1[0];
-    q31 = Q[7] + g13 - c0[3] * k0[1] - c1[3] * k1[1];
-    q22 = Q[10] + Hd[4] + (a02 * g02 + a12 * g12 + a22 * g22 + a32 * g32) - c0[2] * k0[2] - c1[2] * k1[2];
-    q32 = Q[11] + (a03 * g02 + a13 * g12 + a23 * g22 + a33 * g32) - c0[3] * k0[2] - c1[3] * k1[2];
-    q33 = Q[15] + Hd[5] + (a03 * g03 + a13 * g13 + a23 * g23 + a33 * g33) - c0[3] * k0[3] - c1[3] * k1[3];
-    Pn[0] = q00;
-    Pn[1] = q10;
-    Pn[2] = q20;
-    Pn[3] = q30;
-    Pn[4] = q10;
-    Pn[5] = q11;
-    Pn[6] = q21;
-    Pn[7] = q31;
-    Pn[8] = q20;
-    Pn[9] = q21;
-    Pn[10] = q22;
-    Pn[11] = q32;
-    Pn[12] = q30;
-    Pn[13] = q31;
-    Pn[14] = q32;
-    Pn[15] = q33;
-    ocp_qp_kkt_closed_loop(qp, sn, n);
-    return 0;
-}
-
-/* Stage 0 < n < HM_N of the factorisation when, beyond A_n = [e_0 e_1 a_2 a_3], rows 2 and 3 of
- * [A_n B_n] are those of two integrators (the robot's heading and speed: theta += b21 omega,
- * v += b30 a; sn->ab_int): a_2 = (a02, a12, 1, 0), a_3 = (a03, a13, 0, 1) and B = [b00 b01; b10 b11;
- * 0 b21; b30 0]. The path above with the products by these zeros and ones left out, every sum in the
- * same order: the same numbers (up to the sign of a zero; P is stored mirrored, so its columns are
- * its rows). Written so that the compiler runs the products with P as column operations in vector
- * lanes; the scalar code it made of the same sums written entry by entry was slower although it
- * did less arithmetic (docs/benchmarks.md). */
+/* Stage 0 < n < HM_N of the factorisation for the robot's dynamics (sn->ab_int): A_n = [e_0 e_1 a_2 a_3]
+ * (the position enters no other state's update) and rows 2 and 3 of [A_n B_n] are those of two
+ * integrators (heading and speed: theta += b21 omega, v += b30 a), so a_2 = (a02, a12, 1, 0),
+ * a_3 = (a03, a13, 0, 1) and B = [b00 b01; b10 b11; 0 b21; b30 0]. Written out for these shapes:
+ * the symmetric entries once, the products with those zeros and ones left out and every sum kept in
+ * the order of the sum over all four terms, so the results are those of the full products
+ * (x + 0 * y = x, up to the sign of a zero). The products with P are column operations over P's
+ * columns (P is stored mirrored: its columns are its rows), which the compiler runs in vector
+ * lanes; the same sums written entry by entry made scalar code that was slower although it did
+ * less arithmetic (docs/benchmarks.md). */
 HM_FUNC int ocp_qp_kkt_factor_stage_integrators(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn,
                                                 const hm_ocp_qp_ipm_stage *restrict sn1, int n)
 {
@@ -309,10 +196,7 @@ HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_
     hm_real h00 = HM_R(0.0), h10 = HM_R(0.0), h11 = HM_R(0.0);
     int i, j;
 
-    if (n > 0 && n < HM_N && sn->a_id) {
-        if (sn->ab_int) return ocp_qp_kkt_factor_stage_integrators(qp, sn, sn1, n);
-        return ocp_qp_kkt_factor_stage_posfree(qp, sn, sn1, n);
-    }
+    if (n > 0 && n < HM_N && sn->ab_int) return ocp_qp_kkt_factor_stage_integrators(qp, sn, sn1, n);
     if (n < HM_N) {
         const hm_real *restrict P = sn1->P;
         const hm_real *restrict A = qp->A[n];

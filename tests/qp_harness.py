@@ -266,7 +266,8 @@ class Harness:
 
     def kkt_map(self, qp: QP) -> tuple[int, float, dict[str, list[int]]]:
         """(number of packed inequality rows, cost scale, per-stage offsets and counts, and the
-        Riccati kernel of each stage: 0 general, 1 position-free, 2 integrators)."""
+        Riccati path of each stage: 0 general, 1 general with the position-free shortcut, 2 the
+        integrators' kernel)."""
         self.load(qp)
         arrs = {k: self.ffi.new("int[]", self.horizon + 1) for k in ("off", "nb", "nr", "ns", "kernel")}
         m = self.ffi.new("int *")
@@ -572,7 +573,7 @@ class Shape:
     scale: float = 1.0  # magnitude of the linear cost terms (pulls the optimum onto bounds)
     # "general"; "position_free": A = [e_0 e_1 * *] on most stages; "integrators": that, and on most of
     # those stages rows 2 and 3 of [A B] those of two integrators (the robot's heading and speed). Each
-    # is a kernel of the Riccati recursion (ocp_qp_kkt.c), and all that apply meet in one QP.
+    # is a path of the Riccati recursion (ocp_qp_kkt.c), and all that apply meet in one QP.
     dynamics: str = "general"
 
 

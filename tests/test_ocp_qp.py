@@ -132,13 +132,13 @@ def test_riccati_solve_equals_dense_solve_of_the_newton_system(hq: Harness, seed
     rng = np.random.default_rng(seed)
     qp, _, _ = random_qp(rng, N, NG, shape)
     m, cost_scale, stages = hq.kkt_map(qp)
-    # the kernel the data's structure calls for: so every kernel of the recursion is under test
+    # the path the data's structure calls for: so every path of the recursion is under test
     eye = np.eye(NX)
     pos_free = [np.array_equal(qp.A[n][:, :2], eye[:, :2]) for n in range(N)]
     integ = [pos_free[n] and np.array_equal(qp.A[n][2:], eye[2:]) and qp.B[n][2, 0] == 0 and qp.B[n][3, 1] == 0
              for n in range(N)]
     want = [2 if i else 1 if p else 0 for p, i in zip(pos_free, integ, strict=True)]
-    assert stages["kernel"] == [0, *want[1:], 0]  # stages 0 and N have kernels of their own
+    assert stages["kernel"] == [0, *want[1:], 0]  # stages 0 and N take the general path
     cf = conic_form(qp)
     assert m == cf.Ain.shape[0]  # the C solver packs the same rows
     w = 10.0 ** rng.uniform(-log_w, log_w, m)

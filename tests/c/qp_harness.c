@@ -193,8 +193,9 @@ static void qp_harness_row_map(int n, int *kind, int *fam)
 /* Builds the row map of the current problem; arrays have HM_N + 1 entries (packed offsets and
  * counts: bound sides, general rows, soft rows). Also reports the cost scale the Newton system is
  * built with. Returns the setup status (HM_QP_INFEASIBLE for crossing bounds). */
-/* Per stage: the offset and counts of its packed inequality rows, and the kernel of the Riccati
- * recursion its dynamics take (ocp_qp_kkt.c: 0 general, 1 position-free, 2 integrators). */
+/* Per stage: the offset and counts of its packed inequality rows, and the path of the Riccati
+ * recursion its dynamics take (ocp_qp_kkt.c: 0 general, 1 general with the position-free shortcut,
+ * 2 the integrators' kernel). */
 int qp_harness_kkt_map(int *m, int *off, int *nb, int *nr, int *ns, int *kernel, double *cost_scale)
 {
     int bad = 0, n, k, total = 0;
