@@ -911,6 +911,29 @@ HM_FUNC void ocp_qp_ipm_pass_a(hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha, ocp
     sm->ncr = HM_INF;
 }
 
+/* The rows' part of A' w at stage n > 0 (on (px, py): -d z of each row), subtracted from atw. */
+HM_KERNEL void ocp_qp_ipm_rows_atw(const hm_ocp_qp_ipm_stage *restrict sn, const hm_ocp_qp_ipm_rows *restrict sr,
+                                   hm_real *restrict atw)
+{
+    int j;
+    for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
+        atw[HM_NU] -= sr->sd0[j] * sr->sz[j];
+        atw[HM_NU + 1] -= sr->sd1[j] * sr->sz[j];
+    }
+    for (j = 0; j < sn->nh2; j++) {
+        atw[HM_NU] -= sn->hd0[j] * sn->hz[j];
+        atw[HM_NU + 1] -= sn->hd1[j] * sn->hz[j];
+    }
+}
+
+/* The bound pairs' part of A' w at stage n (sign * z of each side), added to atw. */
+HM_KERNEL void ocp_qp_ipm_bounds_atw(const hm_ocp_qp_ipm_bounds *restrict bd, int n, hm_real *restrict atw)
+{
+    int k;
+    for (k = 0; k < bd->nbp; k++)
+        atw[bd->bc[k]] += bd->sg[k][0][n] * bd->z[k][0][n] + bd->sg[k][1][n] * bd->z[k][1][n];
+}
+
 /* The exact stage measures of the iterate left by pass A (see ocp_qp_ipm_sums): the residuals of
  * the dynamics and of the stationarity of (u, x) evaluated afresh (the predictor's gradient ha
  * corrected by the difference to the recurred ones), the norms of A' w, P v and A_E v, and q' v,
@@ -923,7 +946,7 @@ HM_FUNC void ocp_qp_ipm_stage_measures(const hm_ocp_qp *restrict qp, hm_ocp_qp_i
     hm_real rd_v[HM_QP_NUX], pv_v[HM_QP_NUX], atw_v[HM_QP_NUX], eq_v[HM_NX], rpe_v[HM_NX];
     const hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     const hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
-    int n, i, j, k;
+    int n, i, k;
 
     for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = pv_v[i] = atw_v[i] = HM_R(0.0);
     for (i = 0; i < HM_NX; i++) eq_v[i] = rpe_v[i] = HM_R(0.0);
@@ -977,19 +1000,11 @@ HM_FUNC void ocp_qp_ipm_stage_measures(const hm_ocp_qp *restrict qp, hm_ocp_qp_i
                     atw[HM_NU + i] -= (a[0] * y[0] + a[1] * y[1]) + (a[2] * y[2] + a[3] * y[3]);
                 }
             }
-            for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
-                atw[HM_NU] -= sr->sd0[j] * sr->sz[j];
-                atw[HM_NU + 1] -= sr->sd1[j] * sr->sz[j];
-            }
-            for (j = 0; j < sn->nh2; j++) {
-                atw[HM_NU] -= sn->hd0[j] * sn->hz[j];
-                atw[HM_NU + 1] -= sn->hd1[j] * sn->hz[j];
-            }
+            ocp_qp_ipm_rows_atw(sn, sr, atw);
         } else {
             for (i = 0; i < HM_NX; i++) atw[HM_NU + i] = HM_R(0.0);
         }
-        for (k = 0; k < bd->nbp; k++)
-            atw[bd->bc[k]] += bd->sg[k][0][n] * bd->z[k][0][n] + bd->sg[k][1][n] * bd->z[k][1][n];
+        ocp_qp_ipm_bounds_atw(bd, n, atw);
 
         /* stationarity of (u, x): r = P v + q + A' w */
         ocp_qp_ipm_hess_mul(sn, ux, Pux);
@@ -1038,7 +1053,7 @@ HM_FUNC void ocp_qp_ipm_stage_measures_start(hm_ocp_qp_ipm_ws *restrict ws, ocp_
     hm_real rd_v[HM_QP_NUX], atw_v[HM_QP_NUX], rpe_v[HM_NX];
     const hm_ocp_qp_ipm_bounds *restrict bd = &ws->u.f.bd;
     const hm_ocp_qp_ipm_rows *restrict sr = &ws->u.f.sr;
-    int n, i, j, k;
+    int n, i;
 
     for (i = 0; i < HM_QP_NUX; i++) rd_v[i] = atw_v[i] = HM_R(0.0);
     for (i = 0; i < HM_NX; i++) rpe_v[i] = HM_R(0.0);
@@ -1055,17 +1070,9 @@ HM_FUNC void ocp_qp_ipm_stage_measures_start(hm_ocp_qp_ipm_ws *restrict ws, ocp_
         /* A' w: the rows and the bound pairs */
         for (i = 0; i < HM_QP_NUX; i++) atw[i] = HM_R(0.0);
         if (n > 0) {
-            for (j = sn->soff; j < sn->soff + sn->ns2; j++) {
-                atw[HM_NU] -= sr->sd0[j] * sr->sz[j];
-                atw[HM_NU + 1] -= sr->sd1[j] * sr->sz[j];
-            }
-            for (j = 0; j < sn->nh2; j++) {
-                atw[HM_NU] -= sn->hd0[j] * sn->hz[j];
-                atw[HM_NU + 1] -= sn->hd1[j] * sn->hz[j];
-            }
+            ocp_qp_ipm_rows_atw(sn, sr, atw);
         }
-        for (k = 0; k < bd->nbp; k++)
-            atw[bd->bc[k]] += bd->sg[k][0][n] * bd->z[k][0][n] + bd->sg[k][1][n] * bd->z[k][1][n];
+        ocp_qp_ipm_bounds_atw(bd, n, atw);
         /* stationarity of (u, x): r = q + A' w */
         for (i = 0; i < HM_QP_NUX; i++) {
             const hm_real ri = sn->q[i] + atw[i];
