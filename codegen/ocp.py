@@ -200,21 +200,18 @@ class OcpModel:
         grad_d = (p - c) * inv_dist
         f_val, f_d, f_dd = collision_potential_derivatives(dist, q, d_th, kappa)
         hess_d = (ca.SX.eye(NP) - grad_d @ grad_d.T) * inv_dist
+        hess_gn = f_dd * (grad_d @ grad_d.T)
+        collision_in = [("p", p), ("h", c), ("q", q), ("d_th", d_th), ("kappa", kappa)]
+        collision_gn_out = [("f", f_val), ("grad_p", f_d * grad_d), ("hess_gn_p", hess_gn)]
         functions.append(
             self._make(
                 "cost_collision",
                 "collision cost f(d(p, h)) of one human at predicted position h, its exact gradient, "
                 "its Gauss-Newton Hessian f''(d) grad d grad d' and its exact Hessian",
-                [("p", p), ("h", c), ("q", q), ("d_th", d_th), ("kappa", kappa)],
-                [
-                    ("f", f_val),
-                    ("grad_p", f_d * grad_d),
-                    ("hess_gn_p", f_dd * (grad_d @ grad_d.T)),
-                    ("hess_p", f_dd * (grad_d @ grad_d.T) + f_d * hess_d),
-                ],
+                collision_in,
+                [*collision_gn_out, ("hess_p", hess_gn + f_d * hess_d)],
             )
         )
-
         # The same without the exact Hessian, for the Gauss-Newton steps (every RTI step, for every
         # human at every node): CasADi evaluates every output, and the exact Hessian's terms were a
         # seventh of the preparation (docs/benchmarks.md).
@@ -223,12 +220,8 @@ class OcpModel:
                 "cost_collision_gn",
                 "collision cost f(d(p, h)) of one human at predicted position h, its exact gradient and "
                 "its Gauss-Newton Hessian f''(d) grad d grad d' (cost_collision without the exact Hessian)",
-                [("p", p), ("h", c), ("q", q), ("d_th", d_th), ("kappa", kappa)],
-                [
-                    ("f", f_val),
-                    ("grad_p", f_d * grad_d),
-                    ("hess_gn_p", f_dd * (grad_d @ grad_d.T)),
-                ],
+                collision_in,
+                collision_gn_out,
             )
         )
 
