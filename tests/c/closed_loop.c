@@ -10,7 +10,9 @@
  * Every step: the command is finite; a stop has a reason and no other step has one; whenever the
  * robot is within d_h of a present human a stop is in force; a step without a stop solved its QP.
  * Now and then a NaN is injected into one input (and must give a stop). Prints the counts per stop
- * reason; the exit status is the number of violated invariants (capped), 0 when none.
+ * reason and an FNV-1a hash of the state and the command of every step (two builds that print the
+ * same hash took the same steps bit for bit); the exit status is the number of violated
+ * invariants (capped), 0 when none.
  * Built with -DOCP_QP_IPM_PROFILE (and _POSIX_C_SOURCE for the clock), it also prints where the
  * steps' time went: the solver's preparation and step timers, and the QP solver's parts
  * (ocp_qp_ipm.c), in microseconds per step (docs/pass_profile.sh).
@@ -71,6 +73,14 @@ static void spawn(int j, const double *robot)
     }
 }
 
+static unsigned long long fnv1a(unsigned long long h, const void *data, size_t size)
+{
+    const unsigned char *b = (const unsigned char *)data;
+    size_t i;
+    for (i = 0; i < size; i++) h = (h ^ b[i]) * 1099511628211ULL;
+    return h;
+}
+
 static double wrap(double v, double lo, double hi)
 {
     const double w = hi - lo;
@@ -89,6 +99,7 @@ int main(int argc, char **argv)
     const int fixed = argc > 4 && strcmp(argv[4], "fixed") == 0;
     int k = fixed || NH_ALLOC < 5 ? NH_ALLOC : 5, g = 0, j, n;
     long qp_iterations = 0;
+    unsigned long long xu_hash = 1469598103934665603ULL; /* FNV-1a of x and u at every step: bit-identity checks */
     double total_ms = 0.0, prepare_ms = 0.0;
     rng_state = (unsigned long long)(argc > 2 ? atol(argv[2]) : 1) * 2654435761ULL + 1ULL;
     if (NH_ALLOC > 64) return 100;
@@ -170,6 +181,8 @@ int main(int argc, char **argv)
         prepare_ms += out.time_prepare_ms;
         closest = fmin(closest, d_now);
 
+        xu_hash = fnv1a(xu_hash, x, sizeof x);
+        xu_hash = fnv1a(xu_hash, out.u0, sizeof out.u0);
         { /* the plant: the unicycle under the command, finely integrated */
             int sub;
             for (sub = 0; sub < 10; sub++) {
@@ -196,6 +209,6 @@ int main(int argc, char **argv)
 #ifdef OCP_QP_IPM_PROFILE
     for (j = 0; j < 7; j++) printf(", \"%s_us\": %.3f", profile_parts[j], 1e-3 * ocp_qp_ipm_profile_ns[j] / (double)steps);
 #endif
-    printf("}\n");
+    printf(", \"xu_hash\": \"%016llx\"}\n", xu_hash);
     return violations > 100 ? 100 : (int)violations;
 }
