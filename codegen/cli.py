@@ -1,4 +1,4 @@
-"""The humanmpc-gen command line: check, generate, build."""
+"""The generator's commands (check, generate, build, info, keys), mounted by humanmpc-gen (humanmpc.cli)."""
 
 from __future__ import annotations
 
@@ -58,33 +58,6 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_bench(args: argparse.Namespace) -> int:
-    from humanmpc.bench import markdown_table, run_bench
-
-    if args.compare:
-        from humanmpc.compare import run_compare_from_args
-
-        return run_compare_from_args(args)
-
-    try:
-        humans = [int(h) for h in args.humans.split(",")]
-    except ValueError:
-        raise SpecError([f"--humans: {args.humans!r} is not a comma-separated list of integers"], "bench") from None
-    if any(h < 0 or h > 200 for h in humans):
-        raise SpecError([f"--humans: {args.humans!r}: each count must be in 0..200"], "bench")
-    results = run_bench(load_spec(args.spec), humans, seeds=args.seeds, steps=args.steps, out_dir=args.out)
-    print(markdown_table(results), end="")
-    print(f"(written to {args.out / 'bench.json'} and {args.out / 'bench.md'})")
-    return 0
-
-
-def _cmd_demo(args: argparse.Namespace) -> int:
-    from humanmpc.demo import run_demo
-
-    run_demo(seed=args.seed, out_dir=args.out)
-    return 0
-
-
 def _cmd_keys(args: argparse.Namespace) -> int:
     width = max(len(k) for k, _, _ in describe_schema())
     for key, doc, default in describe_schema():
@@ -92,14 +65,8 @@ def _cmd_keys(args: argparse.Namespace) -> int:
     return 0
 
 
-def make_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="humanmpc-gen",
-        description="Generate fixed-size, malloc-free C solvers for human-aware navigation MPC from a YAML spec.",
-    )
-    parser.add_argument("--version", action="version", version=f"humanmpc {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-
+def add_generator_commands(sub: argparse._SubParsersAction) -> None:
+    """The generator's subcommands: check, generate, build, info, keys."""
     p = sub.add_parser("check", help="validate a spec and print it resolved (defaults filled in)",
                        description="Validate SPEC (or the built-in default spec) and print the resolved spec.")
     p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
@@ -127,51 +94,43 @@ def make_parser() -> argparse.ArgumentParser:
     p.add_argument("dir", type=Path, help="generated solver folder")
     p.set_defaults(func=_cmd_info)
 
-    p = sub.add_parser("bench", help="time the real-time iteration in random crowds",
-                       description="Generate one solver per crowd size and time its RTI steps in seeded "
-                       "closed loops (humans at constant velocity, one obstacle near the path).")
-    p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
-    p.add_argument("--humans", default="5,10,20,30", help="crowd sizes N_h (default: 5,10,20,30)")
-    p.add_argument("--seeds", type=int, default=3, help="closed loops per crowd size (default: 3)")
-    p.add_argument("--steps", type=int, default=300, help="RTI steps per closed loop (default: 300)")
-    p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
-    from humanmpc.compare import add_compare_arguments  # the Python package depends on codegen, not back
-
-    add_compare_arguments(p)
-    p.set_defaults(func=_cmd_bench)
-
-    from humanmpc.sim_commands import add_evaluate_parser, add_simulate_parser
-
-    add_simulate_parser(sub)
-    add_evaluate_parser(sub)
-    from .firmware import add_firmware_parser
-
-    add_firmware_parser(sub)
-
-    p = sub.add_parser("demo", help="the main job: both planners in the crossing-group scenario",
-                       description="Generate the default solver, run the crossing-group scenario with the MPC "
-                       "and the DWB baseline, print their metrics side by side and the timing summary, "
-                       "and write the figure.")
-    p.add_argument("--seed", type=int, default=0, help="scenario seed (default 0)")
-    p.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
-    p.set_defaults(func=_cmd_demo)
-
     p = sub.add_parser("keys", help="list every spec key with its default and meaning",
                        description="List every spec key with its default value and meaning.")
     p.set_defaults(func=_cmd_keys)
+
+
+# What the generator's commands raise for a user's mistake or a failed tool: reported in one line.
+GENERATOR_ERRORS: tuple[type[Exception], ...] = (GenerateError, BuildError, FileNotFoundError)
+
+
+def make_parser(prog: str = "humanmpc-gen") -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=prog,
+        description="Generate fixed-size, malloc-free C solvers for human-aware navigation MPC from a YAML spec.",
+    )
+    parser.add_argument("--version", action="version", version=f"humanmpc {__version__}")
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    args = make_parser().parse_args(argv)
+def run(parser: argparse.ArgumentParser, argv: Sequence[str] | None,
+        errors: tuple[type[Exception], ...] = GENERATOR_ERRORS) -> int:
+    """Parse argv, run the chosen command; a spec error exits 2, another known error 1, both in one line."""
+    args = parser.parse_args(argv)
     try:
         return int(args.func(args))
     except SpecError as err:
-        print(f"humanmpc-gen: {err}", file=sys.stderr)
+        print(f"{parser.prog}: {err}", file=sys.stderr)
         return 2
-    except (GenerateError, BuildError, FileNotFoundError) as err:
-        print(f"humanmpc-gen: {err}", file=sys.stderr)
+    except errors as err:
+        print(f"{parser.prog}: {err}", file=sys.stderr)
         return 1
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """The generator alone (python -m humanmpc.codegen): the full tool is humanmpc-gen (humanmpc.cli)."""
+    parser = make_parser("python -m humanmpc.codegen")
+    add_generator_commands(parser.add_subparsers(dest="command", required=True, metavar="COMMAND"))
+    return run(parser, argv)
 
 
 if __name__ == "__main__":

@@ -17,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from humanmpc.evaluate import evaluate
-from humanmpc.mpc_planner import MPCPlanner, MPCPlannerConfig, with_params
-from humanmpc.registry import register_planner
-from humanmpc.scenarios import SCENARIOS
+from humanmpc.eval.evaluate import evaluate
+from humanmpc.planners.mpc import MPCPlanner, MPCPlannerConfig, with_params
+from humanmpc.planners.registry import register_planner
+from humanmpc.sim.scenarios import SCENARIOS
 
 SEEDS = list(range(20))
 PAPER_W_GOAL = (0.5, 0.5, 0.0, 250.0)

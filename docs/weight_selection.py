@@ -16,10 +16,10 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from humanmpc.evaluate import evaluate
-from humanmpc.mpc_planner import MPCPlanner, MPCPlannerConfig, with_params
-from humanmpc.registry import register_planner
-from humanmpc.scenarios import SCENARIOS
+from humanmpc.eval.evaluate import evaluate
+from humanmpc.planners.mpc import MPCPlanner, MPCPlannerConfig, with_params
+from humanmpc.planners.registry import register_planner
+from humanmpc.sim.scenarios import SCENARIOS
 
 W_SPEED = (250.0, 100.0, 50.0, 25.0)
 QS = (20.0, 50.0, 100.0)

@@ -5,9 +5,8 @@
     x_next, A, B = solver.model.dynamics(x, u)
 """
 
-from humanmpc.codegen import __version__
-
 from .bindings import Dims, LoadError, load
+from .codegen import __version__
 from .solver import Solver, StepResult
 
 __all__ = ["Dims", "LoadError", "Solver", "StepResult", "__version__", "load"]

@@ -18,8 +18,7 @@ import cffi
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from humanmpc.codegen.build import build, is_stale
-
+from .codegen.build import build, is_stale
 from .solver import Solver
 
 FloatArray = NDArray[np.float64]

@@ -13,7 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from .solver import QP_STATUS_NAMES, STATUS_NAMES, STOP_REASONS, StepResult
+from .results import StepResult
+from .status import QP_STATUS_NAMES, STATUS_NAMES, STOP_REASONS
 
 FIELDS = (
     ("step", np.int64),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from humanmpc.bench import markdown_table, summarize
+from humanmpc.compare.bench import markdown_table, summarize
 
 
 def _samples(statuses: list[int], c_ms: list[float], reasons: list[int]) -> dict[str, list[float]]:

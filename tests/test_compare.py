@@ -11,9 +11,16 @@ import pytest
 
 from humanmpc.codegen.resources import PROJECT_ROOT
 from humanmpc.codegen.spec import resolve_spec
-from humanmpc.compare import SOLVERS, SolverStats, add_compare_arguments, compare, find_python312, markdown_section
-from humanmpc.reference_ipopt import ipopt_unavailable_reason
-from humanmpc.replay import synthetic_replay
+from humanmpc.compare.peers.acados import find_python312
+from humanmpc.compare.peers.ipopt import ipopt_unavailable_reason
+from humanmpc.compare.replay import synthetic_replay
+from humanmpc.compare.report import (
+    SOLVERS,
+    SolverStats,
+    add_compare_arguments,
+    compare,
+    markdown_section,
+)
 
 
 def test_compare_writes_table_plot_and_json(tmp_path: Path) -> None:

@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 import humanmpc
-from humanmpc.codegen import firmware as fw
-from humanmpc.replay import Replay
+from humanmpc.compare.replay import Replay
+from humanmpc.firmware import image as fw
 
 from .conftest import make_solver, require_tool
 

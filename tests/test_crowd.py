@@ -12,9 +12,15 @@ from types import ModuleType
 import numpy as np
 import pytest
 
-from humanmpc.crowd import Crowd, CrowdSpec
-from humanmpc.social_force import SocialForceParams, group_forces, obstacle_force, obstacle_force_samples, social_force
-from humanmpc.world import Polygon, World
+from humanmpc.sim.crowd import Crowd, CrowdSpec
+from humanmpc.sim.social_force import (
+    SocialForceParams,
+    group_forces,
+    obstacle_force,
+    obstacle_force_samples,
+    social_force,
+)
+from humanmpc.sim.world import Polygon, World
 
 CONTACT = 0.5  # two human radii of 0.25 m
 

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from humanmpc.crowd import CrowdSpec
-from humanmpc.dwb import DWBConfig, DWBPlanner, sample_window
-from humanmpc.episode import run_episode
-from humanmpc.planner import Observation, Planner
-from humanmpc.robot import RobotModel
-from humanmpc.scenarios import Scenario
-from humanmpc.world import Circle, Polygon, World
+from humanmpc.eval.episode import run_episode
+from humanmpc.planners.dwb import DWBConfig, DWBPlanner, sample_window
+from humanmpc.planners.interface import Observation, Planner
+from humanmpc.sim.crowd import CrowdSpec
+from humanmpc.sim.robot import RobotModel
+from humanmpc.sim.scenarios import Scenario
+from humanmpc.sim.world import Circle, Polygon, World
 
 NOBODY = CrowdSpec.build(np.zeros((0, 2)), [], 1.0)
 

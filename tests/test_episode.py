@@ -9,15 +9,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from humanmpc.dwb import DWBPlanner
-from humanmpc.episode import run_episode
-from humanmpc.evaluate import evaluate
-from humanmpc.metrics import compute_metrics
-from humanmpc.planner import Observation, PlanResult
-from humanmpc.plots import animate_episode, plot_episodes
-from humanmpc.registry import make_planner, planner_names, register_planner
-from humanmpc.scenarios import make_scenario
-from humanmpc.sim_commands import add_evaluate_parser, add_simulate_parser
+from humanmpc.eval.commands import add_evaluate_parser, add_simulate_parser
+from humanmpc.eval.episode import run_episode
+from humanmpc.eval.evaluate import evaluate
+from humanmpc.eval.metrics import compute_metrics
+from humanmpc.eval.plots import animate_episode, plot_episodes
+from humanmpc.planners.dwb import DWBPlanner
+from humanmpc.planners.interface import Observation, PlanResult
+from humanmpc.planners.registry import make_planner, planner_names, register_planner
+from humanmpc.sim.scenarios import make_scenario
 
 
 class Recorder:

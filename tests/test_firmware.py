@@ -1,4 +1,4 @@
-"""The generated solver as Cortex-M firmware under QEMU (codegen/firmware.py, templates/firmware/).
+"""The generated solver as Cortex-M firmware under QEMU (humanmpc.firmware, templates/firmware/).
 
 Real parts only: Debian's arm-none-eabi-gcc and newlib, qemu-system-arm on the MPS2 boards
 (mps2-an500: Cortex-M7 with a double-precision FPU; mps2-an386: Cortex-M4F, single precision),
@@ -29,8 +29,8 @@ import numpy as np
 import pytest
 
 import humanmpc
-from humanmpc.codegen import firmware as fw
-from humanmpc.replay import Replay
+from humanmpc.compare.replay import Replay
+from humanmpc.firmware import image as fw
 
 from .conftest import make_solver, require_tool
 

@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 import humanmpc
-from humanmpc.codegen import firmware as fw
 from humanmpc.codegen.casadi_emit import make_single_precision
 from humanmpc.codegen.spec import FLOAT_MIN_QP_TOL, SpecError, resolve_spec
-from humanmpc.replay import Replay
+from humanmpc.compare.replay import Replay
+from humanmpc.firmware import image as fw
 
 from .conftest import make_solver, require_tool
 from .test_firmware import FLOAT_U0_MEDIAN_TOL, FLOAT_U0_TOL

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import humanmpc
-from humanmpc.codegen import cli
+from humanmpc import cli
 from humanmpc.codegen.build import BuildError, build
 from humanmpc.codegen.generate import GenerateError, generate, write_atomically
 from humanmpc.codegen.spec import Spec, resolve_spec
@@ -168,7 +168,8 @@ def test_cli_generate_then_build(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert "N=8 intervals" in printed and "cli_robot_dynamics(x, u) -> x_next, A, B" in printed
 
 
-@pytest.mark.parametrize("command", [[], ["check"], ["generate"], ["build"], ["info"], ["keys"]])
+@pytest.mark.parametrize("command", [[], ["check"], ["generate"], ["build"], ["info"], ["keys"], ["bench"],
+                                     ["simulate"], ["evaluate"], ["firmware"], ["firmware-report"], ["demo"]])
 def test_every_command_has_help(command: list[str], capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as info:
         cli.main([*command, "--help"])
@@ -184,7 +185,7 @@ def test_host_tuned_build_gives_the_same_bits_as_a_portable_one(tmp_path: Path) 
     import numpy as np
 
     from humanmpc.codegen.build import HOST_CFLAGS, PORTABLE_CFLAGS, host_cflags
-    from humanmpc.replay import synthetic_replay
+    from humanmpc.compare.replay import synthetic_replay
 
     assert host_cflags("gcc") == HOST_CFLAGS  # gcc on the development machines takes them
     d = make_solver(tmp_path, {"name": "flags", "humans": {"max": 4}}, built=False)

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from humanmpc.episode import EpisodeLog
-from humanmpc.metrics import compute_metrics, mean_jerk, rising_edges
-from humanmpc.robot import RobotModel
-from humanmpc.world import Circle, World
+from humanmpc.eval.episode import EpisodeLog
+from humanmpc.eval.metrics import compute_metrics, mean_jerk, rising_edges
+from humanmpc.sim.robot import RobotModel
+from humanmpc.sim.world import Circle, World
 
 DT = 0.1
 

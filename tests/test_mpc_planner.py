@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 
 import humanmpc
-from humanmpc.crowd import CrowdSpec
-from humanmpc.episode import run_episode
-from humanmpc.global_path import GlobalPlanner
-from humanmpc.metrics import compute_metrics
-from humanmpc.mpc_planner import EVALUATION_PARAMS, MPCPlanner, MPCPlannerConfig, is_loop, with_params
-from humanmpc.planner import Observation
-from humanmpc.scenarios import Scenario
-from humanmpc.world import Polygon, World
+from humanmpc.eval.episode import run_episode
+from humanmpc.eval.metrics import compute_metrics
+from humanmpc.planners.global_path import GlobalPlanner
+from humanmpc.planners.interface import Observation
+from humanmpc.planners.mpc import EVALUATION_PARAMS, MPCPlanner, MPCPlannerConfig, is_loop, with_params
+from humanmpc.sim.crowd import CrowdSpec
+from humanmpc.sim.scenarios import Scenario
+from humanmpc.sim.world import Polygon, World
 
 PAPER_SPEED_WEIGHT = with_params(MPCPlannerConfig(), w_goal=(0.5, 0.5, 0.0, 250.0))  # the paper's w_goal
 NOBODY = CrowdSpec.build(np.zeros((0, 2)), [], 1.0)

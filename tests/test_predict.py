@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from humanmpc.predict import ConstantVelocityPredictor, Predictor
+from humanmpc.sim.predict import ConstantVelocityPredictor, Predictor
 
 
 def test_prediction_is_exact_for_constant_velocity_motion() -> None:

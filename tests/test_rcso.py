@@ -10,8 +10,8 @@ import pytest
 
 from humanmpc.codegen.reference_nlp import ReferenceNlp
 from humanmpc.codegen.spec import resolve_spec
-from humanmpc.compare import plan_costs, rcso, reference_costs
-from humanmpc.replay import Replay
+from humanmpc.compare.rcso import plan_costs, rcso, reference_costs
+from humanmpc.compare.replay import Replay
 
 
 def test_rcso_of_a_constructed_sequence() -> None:

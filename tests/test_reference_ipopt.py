@@ -12,14 +12,14 @@ import pytest
 
 from humanmpc.codegen.reference_nlp import ReferenceNlp, problem_params
 from humanmpc.codegen.spec import Spec, resolve_spec
-from humanmpc.reference_ipopt import (
+from humanmpc.compare.peers.ipopt import (
     IpoptReference,
     IpoptRunError,
     build_ipopt_reference,
     ipopt_unavailable_reason,
     status_name,
 )
-from humanmpc.replay import Replay, ReplayError, synthetic_replay
+from humanmpc.compare.replay import Replay, ReplayError, synthetic_replay
 
 from . import nlp_reference as indep
 from .conftest import require_tool

@@ -12,7 +12,7 @@ import pytest
 
 import humanmpc
 from humanmpc.codegen.spec import resolve_spec
-from humanmpc.replay import Replay, ReplayError, concatenate, replay_solver, synthetic_replay
+from humanmpc.compare.replay import Replay, ReplayError, concatenate, replay_solver, synthetic_replay
 
 from .conftest import make_solver
 

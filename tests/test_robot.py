@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from humanmpc.robot import RobotLimits, RobotModel, step
+from humanmpc.sim.robot import RobotLimits, RobotModel, step
 
 MODEL = RobotModel()
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from humanmpc.scenarios import SCENARIOS, make_scenario
+from humanmpc.sim.scenarios import SCENARIOS, make_scenario
 
 
 @pytest.mark.parametrize("name", sorted(SCENARIOS))

@@ -10,7 +10,7 @@ import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from humanmpc.codegen import cli
+from humanmpc import cli
 from humanmpc.codegen.spec import Spec, SpecError, describe_schema, parse_spec_text, resolve_spec
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from humanmpc.world import Circle, Polygon, World
+from humanmpc.sim.world import Circle, Polygon, World
 
 BOUNDS = (-10.0, 10.0, -10.0, 10.0)
 

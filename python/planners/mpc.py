@@ -6,7 +6,7 @@ unchanged). Around the OCP it does what the paper's ROS controller plugin does a
 what the DWB baseline of the evaluation gets as well (:class:`MPCPlannerConfig`):
 
 - the goal it hands the OCP: a carrot ``lookahead`` metres along a global path from the global
-  planner the DWB uses too (:class:`~humanmpc.global_path.GlobalPlanner`: A* on the static map,
+  planner the DWB uses too (:class:`~humanmpc.planners.global_path.GlobalPlanner`: A* on the static map,
   replanned at 1 Hz), with the path's heading there; or, with ``global_path=False``, the final
   goal itself. The DWB's global path also avoids the humans' current positions; the MPC's does
   not (``path_humans=False``): the OCP handles the humans with their predictions, and a path
@@ -41,15 +41,14 @@ from typing import Any
 
 import numpy as np
 
-from humanmpc.codegen.build import build, is_stale
-from humanmpc.codegen.generate import MANIFEST, generate
-from humanmpc.codegen.resources import PROJECT_ROOT
-from humanmpc.codegen.spec import Spec
-
-from .bindings import load
+from ..bindings import load
+from ..codegen.build import build, is_stale
+from ..codegen.generate import MANIFEST, generate
+from ..codegen.resources import PROJECT_ROOT
+from ..codegen.spec import Spec
+from ..solver import Solver
 from .global_path import GlobalPlanner, GridConfig, local_segment
-from .planner import Observation, PlanResult
-from .solver import Solver
+from .interface import Observation, PlanResult
 
 DEFAULT_SOLVER_DIR = PROJECT_ROOT / "generated" / "paper"
 GOAL_TAPER = 0.5  # v_ref <= GOAL_TAPER * distance to the goal

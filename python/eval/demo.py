@@ -14,12 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..planners.mpc import ensure_solver
+from ..planners.registry import make_planner
+from ..sim.scenarios import make_scenario
 from .episode import EpisodeLog, run_episode
 from .metrics import compute_metrics
-from .mpc_planner import ensure_solver
 from .plots import plot_episodes
-from .registry import make_planner
-from .scenarios import make_scenario
 
 SCENARIO = "crossing_group"
 PLANNERS = ("mpc", "mpc_paper", "dwb")

@@ -19,8 +19,6 @@ N_h on both CPUs and both precisions, and the instructions per RTI step on a rep
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
 import shutil
 import struct
@@ -28,20 +26,20 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import __version__
-from .build import read_manifest
-from .render import make_environment
-from .spec import Spec, SpecError, load_spec, resolve_spec
+from ..codegen import __version__
+from ..codegen.build import read_manifest
+from ..codegen.render import make_environment
+from ..codegen.spec import Spec, load_spec
 
 if TYPE_CHECKING:
-    from humanmpc.replay import Replay
-    from humanmpc.solver import Solver, StepResult
+    from ..compare.replay import Replay
+    from ..solver import Solver, StepResult
 
 # -- targets ------------------------------------------------------------------------------------
 
@@ -125,7 +123,7 @@ def record_replay(solver: Solver, *, steps: int = 60, seed: int = 0, n_humans: i
     is its closest point. Predictions are constant-velocity, the robot moves by the model itself
     under u0.
     """
-    from humanmpc.replay import Replay
+    from ..compare.replay import Replay
 
     spec = package_spec(solver.path)
     nh = spec.humans.max if n_humans is None else n_humans
@@ -425,7 +423,7 @@ def forbidden_symbols(elf: Path, real: str) -> dict[str, list[str]]:
 def host_results(solver: Solver, replay: Replay, *, cold: bool = False) -> list[StepResult]:
     """The host library on the same replay (fresh start, the replay's parameters); cold: reset before
     every step, as the firmware does with cold=True."""
-    from humanmpc.replay import replay_solver
+    from ..compare.replay import replay_solver
 
     if not cold:
         return list(replay_solver(solver, replay, keep_results=True).results)
@@ -469,7 +467,7 @@ def compare_with_host(run: FirmwareRun, host: Sequence[StepResult]) -> Agreement
 # -- the commands -------------------------------------------------------------------------------
 
 
-def _say(msg: str) -> None:
+def print_progress(msg: str) -> None:
     print(msg, file=sys.stderr)
 
 
@@ -479,7 +477,7 @@ def run_firmware(solver_dir: str | Path, cpu: str, replay: Replay | None = None,
     """Record (or take) a replay, build and run it on cpu, compare with the host; (run, agreement, elf)."""
     import humanmpc
 
-    say = log or _say
+    say = log or print_progress
     d = Path(solver_dir).resolve()
     require_tools()
     host = humanmpc.load(d)
@@ -496,174 +494,9 @@ def run_firmware(solver_dir: str | Path, cpu: str, replay: Replay | None = None,
     return run, compare_with_host(run, host_results(host, replay, cold=cold)), elf
 
 
-def _load_replay(path: Path | None) -> Replay | None:
+def load_replay_file(path: Path | None) -> Replay | None:
     if path is None:
         return None
-    from humanmpc.replay import Replay
+    from ..compare.replay import Replay
 
     return Replay.load(path)
-
-
-STOP_NAMES = {0: "-", 1: "invalid_input", 2: "invalid_params", 3: "deadline", 4: "qp_failed", 5: "nonfinite",
-              6: "human_too_close", 7: "unsafe_plan"}
-
-
-def _cmd_firmware(args: argparse.Namespace) -> int:
-    try:
-        run, agree, elf = run_firmware(args.dir, args.cpu, _load_replay(args.replay), steps=args.steps,
-                                       seed=args.seed, n_humans=args.humans, cold=args.cold, timeout=args.timeout)
-    except FirmwareError as err:
-        print(f"humanmpc-gen: {err}", file=sys.stderr)
-        return 1
-    print(f"# {run.name} ({run.real}) on {args.cpu} under QEMU {CPUS[args.cpu].machine}; "
-          f"sizeof({run.name}_solver) = {run.solver_bytes} B")
-    print(f"{'t':>4} {'status':>6} {'stop':>16} {'qp_it':>5} {'a':>10} {'omega':>10} {'instructions':>13}")
-    for s in run.steps:
-        print(f"{s.t:>4} {s.status:>6} {STOP_NAMES.get(s.stop_reason, s.stop_reason)!s:>16} {s.qp_iterations:>5} "
-              f"{s.u0[0]:>10.6f} {s.u0[1]:>10.6f} {s.instructions:>13,}")
-    ins = run.instructions
-    size = image_size(elf)
-    print(f"instructions per RTI step (QEMU icount, not cycles): mean {ins.mean():,.0f}, min {ins.min():,}, "
-          f"max {ins.max():,}")
-    print(f"replay image: flash {size.flash:,} B (text {size.text:,} + data {size.data:,}; includes the replay), "
-          f"RAM {size.ram:,} B")
-    print(f"against the host library: max |u0 diff| {agree.max_u0_diff:.3g}, max relative cost diff "
-          f"{agree.max_cost_rel_diff:.3g}, same status/stop decisions: {agree.same_decisions}"
-          + (f" ({agree.first_mismatch})" if agree.first_mismatch else ""))
-    return 0
-
-
-# -- the footprint report -----------------------------------------------------------------------
-
-
-@dataclass
-class ReportRow:
-    n_h: int
-    cpu: str
-    precision: str
-    flash: int
-    ram: int
-    text: int
-    data: int
-    bss: int
-    solver_bytes: int
-    insn_mean: float
-    insn_max: int
-    qp_iterations_mean: float  # interior-point iterations per step (steps that solved a QP)
-    steps: int
-    max_u0_diff_to_host: float
-    same_decisions_as_host: bool
-
-
-def footprint_report(base: Spec, humans: Sequence[int], cpus: Sequence[str], precisions: Sequence[str], *,
-                     steps: int, out_dir: Path, seed: int = 0,
-                     log: Callable[[str], None] | None = None) -> list[ReportRow]:
-    """Generate one package per (N_h, precision), build both programs per CPU, run the replay."""
-    import humanmpc
-    from humanmpc.codegen.build import build
-    from humanmpc.codegen.generate import generate
-
-    say = log or _say
-    quiet: Callable[[str], None] = lambda _msg: None  # noqa: E731
-    require_tools()
-    rows: list[ReportRow] = []
-    for nh in humans:
-        replay = None
-        for precision in precisions:
-            data = base.to_dict()
-            data.update(name=f"fw_h{nh}_{precision}", precision=precision)
-            data["humans"]["max"] = nh
-            spec = resolve_spec(data, "report spec")
-            d = generate(spec, out_dir / spec.name, force=True, log=quiet)
-            build(d, log=quiet)
-            host = humanmpc.load(d)
-            if replay is None:  # one replay per N_h, recorded with the first precision's host solver
-                replay = record_replay(host, steps=steps, seed=seed)
-            fw = write_firmware(d, replay)
-            host_steps = host_results(host, replay)
-            for cpu in cpus:
-                say(f"[humanmpc] N_h={nh} {precision} {cpu}")
-                size = image_size(build_firmware(fw, cpu, "footprint"))
-                run = parse_replay_output(run_qemu(build_firmware(fw, cpu, "replay"), cpu))
-                agree = compare_with_host(run, host_steps)
-                ins = run.instructions
-                qp_it = [s.qp_iterations for s in run.steps if s.qp_status >= 0]
-                rows.append(ReportRow(nh, cpu, precision, size.flash, size.ram, size.text, size.data, size.bss,
-                                      run.solver_bytes, float(ins.mean()), int(ins.max()),
-                                      float(np.mean(qp_it)) if qp_it else 0.0, len(ins),
-                                      agree.max_u0_diff, agree.same_decisions))
-    return rows
-
-
-def report_markdown(rows: Sequence[ReportRow]) -> str:
-    out = ["| N_h | CPU | precision | flash [B] (text + data) | RAM [B] (data + bss) | solver struct [B] | "
-           "instructions / RTI step, mean | max | QP iterations / step | steps | same decisions as host |",
-           "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---|"]
-    for r in rows:
-        out.append(f"| {r.n_h} | {r.cpu} | {r.precision} | {r.flash:,} | {r.ram:,} | {r.solver_bytes:,} | "
-                   f"{r.insn_mean:,.0f} | {r.insn_max:,} | {r.qp_iterations_mean:.1f} | {r.steps} | "
-                   f"{'yes' if r.same_decisions_as_host else 'no'} |")
-    return "\n".join(out) + "\n"
-
-
-def _cmd_report(args: argparse.Namespace) -> int:
-    try:
-        humans = [int(h) for h in args.humans.split(",")]
-    except ValueError:
-        raise SpecError([f"--humans: {args.humans!r} is not a comma-separated list of integers"], "firmware-report") \
-            from None
-    cpus = [c.strip() for c in args.cpus.split(",")]
-    precisions = [p.strip() for p in args.precisions.split(",")]
-    bad = [c for c in cpus if c not in CPUS] + [p for p in precisions if p not in ("double", "float")]
-    if bad:
-        raise SpecError([f"unknown CPU or precision {b!r}: CPUs {', '.join(CPUS)}; precisions double, float"
-                         for b in bad], "firmware-report")
-    try:
-        rows = footprint_report(load_spec(args.spec), humans, cpus, precisions, steps=args.steps, out_dir=args.out,
-                                seed=args.seed)
-    except FirmwareError as err:
-        print(f"humanmpc-gen: {err}", file=sys.stderr)
-        return 1
-    table = report_markdown(rows)
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "firmware_report.md").write_text(table)
-    (args.out / "firmware_report.json").write_text(json.dumps([asdict(r) for r in rows], indent=2) + "\n")
-    print(table, end="")
-    print(f"(written to {args.out / 'firmware_report.md'} and .json)")
-    return 0
-
-
-def add_firmware_parser(subparsers: Any) -> None:
-    """The `firmware` and `firmware-report` commands of humanmpc-gen."""
-    p = subparsers.add_parser(
-        "firmware", help="cross-compile a generated solver for a Cortex-M and run a replay under QEMU",
-        description="Write DIR/firmware/ (start-up code, linker script, a replay program with recorded inputs "
-        "embedded as constants, a footprint program, Makefile), cross-compile it with arm-none-eabi-gcc for "
-        "--cpu, run it under qemu-system-arm with semihosting and instruction counting, and compare its results "
-        "with the host library on the same inputs. Without --replay the inputs are recorded from a closed loop "
-        "of the host solver in a random crowd.")
-    p.add_argument("dir", type=Path, help="generated solver folder")
-    p.add_argument("--cpu", choices=sorted(CPUS), default="cortex-m7",
-                   help="cortex-m4 (mps2-an386, single-precision FPU) or cortex-m7 (mps2-an500); default cortex-m7")
-    p.add_argument("--replay", type=Path, help="a replay .npz (humanmpc.replay format) instead of a recorded loop")
-    p.add_argument("--steps", type=int, default=60, help="steps of the recorded loop (default 60)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the recorded crowd (default 0)")
-    p.add_argument("--humans", type=int, help="humans in the recorded crowd (default: the solver's N_h)")
-    p.add_argument("--cold", action="store_true",
-                   help="reset the solver before every step (each step then depends on its own inputs only)")
-    p.add_argument("--timeout", type=float, default=600.0, help="QEMU time limit in seconds (default 600)")
-    p.set_defaults(func=_cmd_firmware)
-
-    p = subparsers.add_parser(
-        "firmware-report", help="footprint and instruction counts over N_h, CPUs and precisions",
-        description="Generate one solver per N_h and precision (from SPEC or the default spec), cross-compile "
-        "the footprint and replay programs for each CPU, run the replays under QEMU and print the table of "
-        "flash, RAM and instructions per RTI step (QEMU icount: instructions, not cycles).")
-    p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
-    p.add_argument("--humans", default="5,10,30", help="N_h values (default 5,10,30)")
-    p.add_argument("--cpus", default="cortex-m4,cortex-m7", help="CPUs (default cortex-m4,cortex-m7)")
-    p.add_argument("--precisions", default="double,float", help="precisions (default double,float)")
-    p.add_argument("--steps", type=int, default=20, help="replay steps per run (default 20)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the recorded crowds (default 0)")
-    p.add_argument("--out", type=Path, default=Path("out/firmware"), help="output folder (default out/firmware)")
-    p.set_defaults(func=_cmd_report)

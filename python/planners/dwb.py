@@ -2,7 +2,7 @@
 
 Per control step:
 
-1. the global path (A* on an inflated grid, :mod:`humanmpc.global_path`) is replanned every
+1. the global path (A* on an inflated grid, :mod:`humanmpc.planners.global_path`) is replanned every
    ``replan_period`` seconds with the humans' *current* positions as obstacles, as nav2's
    default behaviour tree replans at 1 Hz on a costmap whose obstacle layer sees the people;
 2. (v, omega) pairs are sampled in the dynamic window: v within ``a_min dt .. a_max dt`` of the
@@ -32,9 +32,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from humanmpc.global_path import GlobalPlanner, GridConfig, local_segment
-from humanmpc.planner import Observation, PlanResult, protective_stop
-from humanmpc.robot import integrate
+from ..sim.robot import integrate
+from .global_path import GlobalPlanner, GridConfig, local_segment
+from .interface import Observation, PlanResult, protective_stop
 
 FloatArray = NDArray[np.float64]
 

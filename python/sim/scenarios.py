@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from humanmpc.crowd import CrowdSpec
-from humanmpc.world import Circle, Obstacle, Polygon, World
+from .crowd import CrowdSpec
+from .world import Circle, Obstacle, Polygon, World
 
 FloatArray = NDArray[np.float64]
 

@@ -26,12 +26,12 @@ from typing import Any
 
 import numpy as np
 
-from humanmpc.codegen.build import build, compiler_and_flags
-from humanmpc.codegen.generate import generate
-from humanmpc.codegen.spec import Spec, resolve_spec
-
-from .bindings import load
-from .solver import QP_STATUS_NAMES, STOP_REASONS, Solver
+from ..bindings import load
+from ..codegen.build import build, compiler_and_flags
+from ..codegen.generate import generate
+from ..codegen.spec import Spec, resolve_spec
+from ..solver import Solver
+from ..status import QP_STATUS_NAMES, STOP_REASONS
 
 AREA_X = (-1.0, 13.0)
 AREA_Y = (-5.0, 5.0)

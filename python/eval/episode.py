@@ -6,7 +6,7 @@ Per step (period ``dt``, 0.1 s by default):
    from the observations only;
 2. select the obstacle point: the nearest point of the nearest static obstacle to the robot,
    chosen anew every step;
-3. call the planner with an :class:`~humanmpc.planner.Observation`;
+3. call the planner with an :class:`~humanmpc.planners.interface.Observation`;
 4. apply ``u`` to the robot for one period and step the crowd once, the robot taking part in
    the social force model as an agent at its state at the start of the period;
 5. log everything the metrics and plots need.
@@ -25,13 +25,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from humanmpc.crowd import Crowd
-from humanmpc.planner import Observation, Planner
-from humanmpc.predict import ConstantVelocityPredictor, Predictor
-from humanmpc.robot import RobotModel, step, velocity_vector
-from humanmpc.scenarios import Scenario
-from humanmpc.social_force import SocialForceParams
-from humanmpc.world import World
+from ..planners.interface import Observation, Planner
+from ..sim.crowd import Crowd
+from ..sim.predict import ConstantVelocityPredictor, Predictor
+from ..sim.robot import RobotModel, step, velocity_vector
+from ..sim.scenarios import Scenario
+from ..sim.social_force import SocialForceParams
+from ..sim.world import World
 
 FloatArray = NDArray[np.float64]
 

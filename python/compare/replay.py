@@ -24,8 +24,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from humanmpc.codegen.reference_nlp import PROBLEM_PARAMS, ReferenceNlp, check_problem_params, problem_params
-from humanmpc.codegen.spec import Spec, SpecError, resolve_spec
+from ..codegen.reference_nlp import PROBLEM_PARAMS, ReferenceNlp, check_problem_params, problem_params
+from ..codegen.spec import Spec, SpecError, resolve_spec
 
 FloatArray = NDArray[np.float64]
 

@@ -25,9 +25,9 @@ from matplotlib.axes import Axes
 from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon as PolygonPatch
 
-from humanmpc.episode import EpisodeLog
-from humanmpc.metrics import D_TH, human_distances
-from humanmpc.world import World
+from ..sim.world import World
+from .episode import EpisodeLog
+from .metrics import D_TH, human_distances
 
 PLANNER_COLOURS = {"mpc": "tab:red", "dwb": "tab:blue", "mpc_paper": "tab:orange"}
 _OTHER = ["tab:green", "tab:purple", "tab:orange", "tab:brown"]

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from humanmpc.social_force import (
+from .social_force import (
     SocialForceParams,
     desired_force,
     group_forces,
@@ -28,7 +28,7 @@ from humanmpc.social_force import (
     obstacle_force_samples,
     social_force,
 )
-from humanmpc.world import World
+from .world import World
 
 FloatArray = NDArray[np.float64]
 

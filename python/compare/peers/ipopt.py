@@ -25,12 +25,11 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from humanmpc.codegen import __version__
-from humanmpc.codegen.reference_nlp import GeneratedNlp, ReferenceNlp, generate_c
-from humanmpc.codegen.render import c_identifier, make_environment
-from humanmpc.codegen.spec import Spec
-
-from .replay import Replay, ReplayError
+from ...codegen import __version__
+from ...codegen.reference_nlp import GeneratedNlp, ReferenceNlp, generate_c
+from ...codegen.render import c_identifier, make_environment
+from ...codegen.spec import Spec
+from ..replay import Replay, ReplayError
 
 FloatArray = NDArray[np.float64]
 

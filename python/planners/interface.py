@@ -16,8 +16,8 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import NDArray
 
-from humanmpc.robot import RobotModel
-from humanmpc.world import World
+from ..sim.robot import RobotModel
+from ..sim.world import World
 
 FloatArray = NDArray[np.float64]
 

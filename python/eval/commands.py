@@ -1,4 +1,4 @@
-"""``simulate`` and ``evaluate`` sub-commands for the ``humanmpc-gen`` CLI.
+"""``simulate``, ``evaluate`` and ``demo``: the evaluation's sub-commands of ``humanmpc-gen``.
 
 Hook them into the CLI's sub-parsers::
 
@@ -18,16 +18,16 @@ import argparse
 import sys
 from pathlib import Path
 
-from humanmpc.registry import planner_names
-from humanmpc.scenarios import SCENARIOS
+from ..planners.registry import planner_names
+from ..sim.scenarios import SCENARIOS
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from humanmpc.episode import run_episode
-    from humanmpc.metrics import compute_metrics
-    from humanmpc.plots import animate_episode, plot_episodes
-    from humanmpc.registry import make_planner
-    from humanmpc.scenarios import make_scenario
+    from ..planners.registry import make_planner
+    from ..sim.scenarios import make_scenario
+    from .episode import run_episode
+    from .metrics import compute_metrics
+    from .plots import animate_episode, plot_episodes
 
     try:
         scenario = make_scenario(args.scenario, args.seed)
@@ -52,7 +52,7 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _evaluate(args: argparse.Namespace) -> int:
-    from humanmpc.evaluate import evaluate, markdown_table, validate_names
+    from .evaluate import evaluate, markdown_table, validate_names
 
     scenarios = args.scenarios or sorted(SCENARIOS)
     planners = args.planners or planner_names()
@@ -96,4 +96,23 @@ def add_evaluate_parser(subparsers: argparse._SubParsersAction) -> argparse.Argu
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_evaluate)
+    return p
+
+
+def _demo(args: argparse.Namespace) -> int:
+    from .demo import run_demo
+
+    run_demo(seed=args.seed, out_dir=args.out)
+    return 0
+
+
+def add_demo_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``demo [--seed S] [--out DIR]``: what ``make demo`` runs."""
+    p = subparsers.add_parser("demo", help="the main job: both planners in the crossing-group scenario",
+                              description="Generate the default solver, run the crossing-group scenario with the MPC "
+                              "and the DWB baseline, print their metrics side by side and the timing summary, "
+                              "and write the figure.")
+    p.add_argument("--seed", type=int, default=0, help="scenario seed (default 0)")
+    p.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
+    p.set_defaults(func=_demo)
     return p

@@ -2,7 +2,7 @@
 
 Writes to ``out_dir``:
 
-* ``runs.csv``: one row of :class:`~humanmpc.metrics.EpisodeMetrics` per (scenario, planner, seed);
+* ``runs.csv``: one row of :class:`~humanmpc.eval.metrics.EpisodeMetrics` per (scenario, planner, seed);
 * ``summary.csv`` and ``summary.md``: mean and standard deviation per scenario and planner
   (rates for success / timeout, sums are not used: every number is a per-run mean);
 * ``figures/<scenario>_seed<first seed>.png``: the paths of every planner on the first seed.
@@ -20,11 +20,11 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from humanmpc.episode import EpisodeConfig, EpisodeLog, run_episode
-from humanmpc.metrics import compute_metrics
-from humanmpc.plots import plot_episodes
-from humanmpc.registry import make_planner, planner_names
-from humanmpc.scenarios import SCENARIOS, make_scenario
+from ..planners.registry import make_planner, planner_names
+from ..sim.scenarios import SCENARIOS, make_scenario
+from .episode import EpisodeConfig, EpisodeLog, run_episode
+from .metrics import compute_metrics
+from .plots import plot_episodes
 
 SUMMARY_COLUMNS = [
     "success", "collisions", "timeout", "time_to_goal", "path_length", "min_human_distance",

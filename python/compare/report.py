@@ -1,7 +1,7 @@
 """Side by side with the references: humanmpc's SQP-RTI, acados SQP-RTI + HPIPM, Ipopt in C.
 
 Every solver gets the same replay (the inputs of every step of a closed loop, see
-:mod:`humanmpc.replay`), step by step, each keeping its own warm start:
+:mod:`humanmpc.compare.replay`), step by step, each keeping its own warm start:
 
 =================  ====================================================================  ==========================
 solver             what runs                                                             step time
@@ -40,10 +40,8 @@ import argparse
 import json
 import os
 import platform
-import shutil
 import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
@@ -53,224 +51,30 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from humanmpc.codegen.ocp import DIST_EPS
-from humanmpc.codegen.reference_nlp import ReferenceNlp
-from humanmpc.codegen.spec import Spec, load_spec, resolve_spec
-
-from .reference_ipopt import IpoptRun, IpoptUnavailableError, build_ipopt_reference, ipopt_unavailable_reason
+from ..codegen.reference_nlp import ReferenceNlp
+from ..codegen.spec import Spec, load_spec, resolve_spec
+from .peers.acados import (
+    ACADOS_PACKAGE,
+    DEFAULT_ACADOS_VENV,
+    AcadosUnavailableError,
+    ensure_acados_venv,
+    progress,
+    run_acados,
+)
+from .peers.ipopt import IpoptRun, IpoptUnavailableError, build_ipopt_reference, ipopt_unavailable_reason
+from .rcso import plan_costs, rcso, reference_costs
 from .replay import Replay, ReplayRun, replay_solver, synthetic_replay
 
 FloatArray = NDArray[np.float64]
 Log = Callable[[str], None]
 
-ACADOS_PACKAGE = "comma-deps-acados==0.2.2.post104"
-ACADOS_PYTHON = "3.12"
-PEER_SCRIPT = Path(__file__).resolve().parent / "peers" / "acados_peer.py"
-DEFAULT_ACADOS_VENV = Path(".venv-acados")
 SOLVERS = ("humanmpc", "humanmpc exact+LS", "acados default", "acados fastest", "Ipopt cold", "Ipopt warm")
 # The real-time iterations, whose RCSO is also reported over the steps all of them solved.
 RTI_SOLVERS = ("humanmpc", "humanmpc exact+LS", "acados default", "acados fastest")
 # humanmpc's second row: the same generated solver with the exact-Hessian RTI and the merit line search
 # (runtime parameters), the configuration of the behaviour evaluation (docs/evaluation.md).
 EXACT_LS_PARAMS = {"exact_hessian": True, "line_search": True}
-FASTEST = {"cond_N": 5, "qp_iter_max": 50}
 
-
-class AcadosUnavailableError(RuntimeError):
-    """acados cannot run here (no Python 3.12, or its wheel cannot be installed); the message says why."""
-
-
-def _say(log: Log | None) -> Log:
-    return log or (lambda msg: print(msg, file=sys.stderr))
-
-
-# ----------------------------------------------------------------------------------------------
-# The acados virtualenv (Python 3.12, separate from the project's .venv)
-# ----------------------------------------------------------------------------------------------
-
-
-def find_python312() -> Path | None:
-    """A Python 3.12 interpreter: $HUMANMPC_PYTHON312, python3.12 on PATH, or a pyenv 3.12.x."""
-    candidates: list[Path] = []
-    env = os.environ.get("HUMANMPC_PYTHON312")
-    if env:
-        candidates.append(Path(env))
-    which = shutil.which("python3.12")
-    if which:
-        candidates.append(Path(which))
-    pyenv_root = Path(os.environ.get("PYENV_ROOT", Path.home() / ".pyenv"))
-    candidates += sorted((pyenv_root / "versions").glob("3.12*/bin/python3.12"), reverse=True)
-    for c in candidates:
-        if not c.is_file():
-            continue
-        try:
-            out = subprocess.run([str(c), "-c", "import sys, venv; print('%d.%d' % sys.version_info[:2])"],
-                                 capture_output=True, text=True, timeout=30, check=False)
-        except (OSError, subprocess.TimeoutExpired):
-            continue
-        if out.returncode == 0 and out.stdout.strip() == ACADOS_PYTHON:
-            return c
-    return None
-
-
-def _venv_python(venv_dir: Path) -> Path:
-    return venv_dir / "bin" / "python"
-
-
-def _acados_installed(python: Path) -> bool:
-    probe = "import importlib.util as u, sys; sys.exit(0 if u.find_spec('acados') and u.find_spec('casadi') else 1)"
-    try:
-        return subprocess.run([str(python), "-c", probe], capture_output=True, timeout=60, check=False).returncode == 0
-    except (OSError, subprocess.TimeoutExpired):
-        return False
-
-
-def ensure_acados_venv(venv_dir: str | Path = DEFAULT_ACADOS_VENV, *, log: Log | None = None) -> Path:
-    """The interpreter of a Python 3.12 virtualenv holding PyPI's prebuilt acados (created when missing).
-
-    The virtualenv is separate from the project's: acados ships a casadi of its own (3.6.7)
-    that must not meet the project's. Raises AcadosUnavailableError with the reason when Python
-    3.12 is missing or the wheel cannot be installed.
-    """
-    say = _say(log)
-    d = Path(venv_dir).resolve()
-    python = _venv_python(d)
-    if python.is_file() and _acados_installed(python):
-        return python
-    base = find_python312()
-    if base is None:
-        raise AcadosUnavailableError(
-            "acados needs Python 3.12 (PyPI's comma-deps-acados is built for it) and none was found: "
-            "install python3.12 (or pyenv 3.12.x) or point HUMANMPC_PYTHON312 at one"
-        )
-    if not python.is_file():
-        say(f"[compare] creating {d} with {base}")
-        proc = subprocess.run([str(base), "-m", "venv", str(d)], capture_output=True, text=True, check=False)
-        if proc.returncode != 0:
-            raise AcadosUnavailableError(f"could not create the acados virtualenv {d}: {proc.stderr.strip()[-500:]}")
-    say(f"[compare] installing {ACADOS_PACKAGE} into {d}")
-    proc = subprocess.run([str(python), "-m", "pip", "install", "-q", ACADOS_PACKAGE], capture_output=True, text=True,
-                          check=False)
-    if proc.returncode != 0 or not _acados_installed(python):
-        raise AcadosUnavailableError(f"could not install {ACADOS_PACKAGE} into {d}: "
-                                     f"{(proc.stderr or proc.stdout).strip()[-800:]}")
-    return python
-
-
-def acados_unavailable_reason(venv_dir: str | Path = DEFAULT_ACADOS_VENV) -> str | None:
-    """None when the acados peer can run (installing it if needed), else the reason (for skips)."""
-    try:
-        ensure_acados_venv(venv_dir, log=lambda _m: None)
-    except AcadosUnavailableError as err:
-        return str(err)
-    return None
-
-
-@dataclass
-class AcadosRun:
-    """acados' results on every step of a replay."""
-
-    mode: str
-    status: NDArray[np.int64]  # (T,) acados' status: 0 success, 3 minimum step, 4 QP failure, ...
-    qp_iterations: NDArray[np.int64]
-    time_tot_ms: FloatArray  # acados' own timer
-    wall_ms: FloatArray  # wall time of solve() from Python (ctypes)
-    x: FloatArray
-    u: FloatArray
-    info: dict[str, Any]
-
-    @property
-    def failures(self) -> int:
-        return int(np.count_nonzero(self.status != 0))
-
-
-def run_acados(replay: Replay, mode: str, build_dir: str | Path, *, python: Path | None = None,
-               venv_dir: str | Path = DEFAULT_ACADOS_VENV, regularization: float | None = None,
-               cond_n: int = FASTEST["cond_N"], qp_iter_max: int = FASTEST["qp_iter_max"],
-               timeout_s: float = 3600.0, log: Log | None = None) -> AcadosRun:
-    """Run the acados peer (``peers/acados_peer.py``) on a replay, in ``mode`` default or fastest."""
-    py = python or ensure_acados_venv(venv_dir, log=log)
-    build = Path(build_dir).resolve()
-    build.mkdir(parents=True, exist_ok=True)
-    reg = replay.resolved_spec().solver.regularization if regularization is None else regularization
-    with tempfile.TemporaryDirectory(prefix="hm_acados_") as tmp:
-        rp, out = Path(tmp) / "replay.npz", Path(tmp) / "results.npz"
-        replay.save(rp)
-        cmd = [str(py), str(PEER_SCRIPT), str(rp), str(out), "--build", str(build), "--mode", mode,
-               "--dist-eps", repr(DIST_EPS), "--cond-N", str(cond_n), "--qp-iter-max", str(qp_iter_max),
-               "--regularization", repr(float(reg))]
-        env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout_s, check=False, env=env)
-        if proc.returncode != 0 or not out.is_file():
-            raise RuntimeError(f"the acados peer failed (exit {proc.returncode}):\n"
-                               f"{(proc.stderr + proc.stdout).strip()[-3000:]}")
-        with np.load(out, allow_pickle=False) as r:
-            return AcadosRun(mode=mode, status=r["status"].astype(np.int64),
-                             qp_iterations=r["qp_iter"].astype(np.int64), time_tot_ms=r["time_tot_ms"].copy(),
-                             wall_ms=r["wall_ms"].copy(), x=r["x"].copy(), u=r["u"].copy(),
-                             info=json.loads(str(r["info"])))
-
-
-# ----------------------------------------------------------------------------------------------
-# Sub-optimality
-# ----------------------------------------------------------------------------------------------
-
-
-def plan_costs(nlp: ReferenceNlp, replay: Replay, u: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Per step: the objective of the controls u[t] (N, 2) simulated from x0_t, and the largest
-    violation of the hard human rows by that trajectory (m, 0 when none). NaN where u is not finite."""
-    T = replay.steps
-    costs = np.full(T, np.nan)
-    violation = np.full(T, np.nan)
-    for t in range(T):
-        ut = np.asarray(u[t], dtype=np.float64)
-        if not np.all(np.isfinite(ut)):
-            continue
-        inputs = replay.inputs(t)
-        p = nlp.params.pack(**inputs, params=replay.params)
-        X = np.asarray(nlp.rollout(inputs["x0"], ut))
-        costs[t] = float(nlp.plan_cost(X, ut, p))
-        now = inputs["humans_now"]
-        if now.shape[0]:
-            # the problem's smoothed distance, as in the constraint rows
-            d = np.sqrt(np.sum((X[1:, None, :2] - now[None, :, :]) ** 2, axis=2) + DIST_EPS**2)
-            violation[t] = max(0.0, float(np.max(float(np.asarray(replay.params["d_h"]).reshape(-1)[0]) - d)))
-        else:
-            violation[t] = 0.0
-    return costs, violation
-
-
-def reference_costs(costs: Sequence[FloatArray], success: Sequence[NDArray[np.bool_]]) -> FloatArray:
-    """J*_t: the lowest cost among the reference runs that succeeded at step t (NaN where none did).
-
-    ``costs[k]`` are run k's plan costs (``plan_costs``, the same function as for every solver),
-    ``success[k]`` its per-step success."""
-    if not costs or len(costs) != len(success):
-        raise ValueError("give the costs and the success flags of at least one reference run")
-    stacked = np.stack([np.where(np.asarray(ok, dtype=bool), np.asarray(c, dtype=np.float64), np.nan)
-                        for c, ok in zip(costs, success, strict=True)])
-    out = np.full(stacked.shape[1], np.nan)
-    ok = np.any(np.isfinite(stacked), axis=0)
-    out[ok] = np.nanmin(stacked[:, ok], axis=0)
-    return out
-
-
-def rcso(costs: Sequence[float] | FloatArray, optimal: Sequence[float] | FloatArray) -> tuple[float, int]:
-    """Relative cumulative sub-optimality and the number of steps it covers.
-
-    sum_t (costs_t - optimal_t) / sum_t optimal_t over the steps where both are finite.
-    """
-    c = np.asarray(costs, dtype=np.float64)
-    o = np.asarray(optimal, dtype=np.float64)
-    if c.shape != o.shape:
-        raise ValueError(f"costs {c.shape} and optimal costs {o.shape} must have the same shape")
-    ok = np.isfinite(c) & np.isfinite(o)
-    if not np.any(ok):
-        return float("nan"), 0
-    total = float(np.sum(o[ok]))
-    if total <= 0.0:
-        raise ValueError(f"the optimal costs sum to {total}: RCSO needs a positive total")
-    return float(np.sum(c[ok] - o[ok]) / total), int(np.count_nonzero(ok))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -380,7 +184,7 @@ def compare(specs: Sequence[Spec | str | Path], replays: Sequence[Replay | str |
     ``results.json``, ``step_times.png`` and ``benchmarks.md`` (a section for docs/benchmarks.md).
     Solvers in ``skip`` are left out; a solver that cannot run here is reported with the reason.
     """
-    say = _say(log)
+    say = progress(log)
     out = Path(out_dir).resolve()
     out.mkdir(parents=True, exist_ok=True)
     spec_list = [_load_spec(s) for s in specs]
@@ -515,7 +319,7 @@ def _run_ours(spec: Spec, solver_dir: str | Path | None, out: Path, replay: Repl
     if solver_dir is None:
         solver_dir = out / "solvers" / f"{spec.name}_{spec.humans.max}"
         if not (solver_dir / "manifest.json").is_file() or params is None:
-            from humanmpc.codegen.generate import generate
+            from ..codegen.generate import generate
 
             solver_dir = generate(spec, solver_dir, force=True, log=lambda _m: None)
     solver = humanmpc.load(solver_dir)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from humanmpc.world import World
+from ..sim.world import World
 
 FloatArray = NDArray[np.float64]
 

@@ -30,7 +30,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from humanmpc.episode import EpisodeLog
+from .episode import EpisodeLog
 
 FloatArray = NDArray[np.float64]
 

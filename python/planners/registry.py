@@ -1,9 +1,9 @@
 """Planners by name: a factory per name, so the CLI and the evaluation can build them.
 
 ``register_planner("mpc", factory)`` adds a planner; the factory takes no argument and returns
-a fresh :class:`~humanmpc.planner.Planner`. The DWB baseline is registered as ``"dwb"``, the
+a fresh :class:`~humanmpc.planners.interface.Planner`. The DWB baseline is registered as ``"dwb"``, the
 generated MPC as ``"mpc"`` (the evaluation's configuration) and ``"mpc_paper"`` (the paper's OCP with
-its parameters and the final goal; :class:`~humanmpc.mpc_planner.MPCPlannerConfig`).
+its parameters and the final goal; :class:`~humanmpc.planners.mpc.MPCPlannerConfig`).
 Evaluation workers are forked from the registering process, so registrations made before an
 evaluation starts are visible in the workers.
 """
@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from humanmpc.dwb import DWBPlanner
-from humanmpc.planner import Planner
+from .dwb import DWBPlanner
+from .interface import Planner
 
 PlannerFactory = Callable[[], Planner]
 
@@ -44,13 +44,13 @@ def make_planner(name: str) -> Planner:
 
 def _make_mpc() -> Planner:
     # Imported here: loading the MPC generates and builds its solver when that is missing.
-    from humanmpc.mpc_planner import MPCPlanner
+    from .mpc import MPCPlanner
 
     return MPCPlanner(name="mpc")
 
 
 def _make_mpc_paper() -> Planner:
-    from humanmpc.mpc_planner import MPCPlanner, MPCPlannerConfig
+    from .mpc import MPCPlanner, MPCPlannerConfig
 
     return MPCPlanner(config=MPCPlannerConfig.paper(), name="mpc_paper")
 

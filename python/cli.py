@@ -1,0 +1,27 @@
+"""humanmpc-gen: the generator's commands (humanmpc.codegen.cli) and the tools built on the solver."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+
+from .codegen.cli import GENERATOR_ERRORS, add_generator_commands, make_parser, run
+from .compare.commands import add_bench_parser
+from .eval.commands import add_demo_parser, add_evaluate_parser, add_simulate_parser
+from .firmware.commands import add_firmware_parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = make_parser()
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    add_generator_commands(sub)
+    add_bench_parser(sub)
+    add_simulate_parser(sub)
+    add_evaluate_parser(sub)
+    add_firmware_parser(sub)
+    add_demo_parser(sub)
+    return run(parser, argv, GENERATOR_ERRORS)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,105 @@
+"""The `firmware` and `firmware-report` commands of humanmpc-gen."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+from ..codegen.spec import SpecError, load_spec
+from .image import CPUS, FirmwareError, image_size, load_replay_file, run_firmware
+from .report import footprint_report, report_markdown
+
+STOP_NAMES = {0: "-", 1: "invalid_input", 2: "invalid_params", 3: "deadline", 4: "qp_failed", 5: "nonfinite",
+              6: "human_too_close", 7: "unsafe_plan"}
+
+
+def _cmd_firmware(args: argparse.Namespace) -> int:
+    try:
+        run, agree, elf = run_firmware(args.dir, args.cpu, load_replay_file(args.replay), steps=args.steps,
+                                       seed=args.seed, n_humans=args.humans, cold=args.cold, timeout=args.timeout)
+    except FirmwareError as err:
+        print(f"humanmpc-gen: {err}", file=sys.stderr)
+        return 1
+    print(f"# {run.name} ({run.real}) on {args.cpu} under QEMU {CPUS[args.cpu].machine}; "
+          f"sizeof({run.name}_solver) = {run.solver_bytes} B")
+    print(f"{'t':>4} {'status':>6} {'stop':>16} {'qp_it':>5} {'a':>10} {'omega':>10} {'instructions':>13}")
+    for s in run.steps:
+        print(f"{s.t:>4} {s.status:>6} {STOP_NAMES.get(s.stop_reason, s.stop_reason)!s:>16} {s.qp_iterations:>5} "
+              f"{s.u0[0]:>10.6f} {s.u0[1]:>10.6f} {s.instructions:>13,}")
+    ins = run.instructions
+    size = image_size(elf)
+    print(f"instructions per RTI step (QEMU icount, not cycles): mean {ins.mean():,.0f}, min {ins.min():,}, "
+          f"max {ins.max():,}")
+    print(f"replay image: flash {size.flash:,} B (text {size.text:,} + data {size.data:,}; includes the replay), "
+          f"RAM {size.ram:,} B")
+    print(f"against the host library: max |u0 diff| {agree.max_u0_diff:.3g}, max relative cost diff "
+          f"{agree.max_cost_rel_diff:.3g}, same status/stop decisions: {agree.same_decisions}"
+          + (f" ({agree.first_mismatch})" if agree.first_mismatch else ""))
+    return 0
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    try:
+        humans = [int(h) for h in args.humans.split(",")]
+    except ValueError:
+        raise SpecError([f"--humans: {args.humans!r} is not a comma-separated list of integers"], "firmware-report") \
+            from None
+    cpus = [c.strip() for c in args.cpus.split(",")]
+    precisions = [p.strip() for p in args.precisions.split(",")]
+    bad = [c for c in cpus if c not in CPUS] + [p for p in precisions if p not in ("double", "float")]
+    if bad:
+        raise SpecError([f"unknown CPU or precision {b!r}: CPUs {', '.join(CPUS)}; precisions double, float"
+                         for b in bad], "firmware-report")
+    try:
+        rows = footprint_report(load_spec(args.spec), humans, cpus, precisions, steps=args.steps, out_dir=args.out,
+                                seed=args.seed)
+    except FirmwareError as err:
+        print(f"humanmpc-gen: {err}", file=sys.stderr)
+        return 1
+    table = report_markdown(rows)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "firmware_report.md").write_text(table)
+    (args.out / "firmware_report.json").write_text(json.dumps([asdict(r) for r in rows], indent=2) + "\n")
+    print(table, end="")
+    print(f"(written to {args.out / 'firmware_report.md'} and .json)")
+    return 0
+
+
+def add_firmware_parser(subparsers: Any) -> None:
+    """The `firmware` and `firmware-report` commands of humanmpc-gen."""
+    p = subparsers.add_parser(
+        "firmware", help="cross-compile a generated solver for a Cortex-M and run a replay under QEMU",
+        description="Write DIR/firmware/ (start-up code, linker script, a replay program with recorded inputs "
+        "embedded as constants, a footprint program, Makefile), cross-compile it with arm-none-eabi-gcc for "
+        "--cpu, run it under qemu-system-arm with semihosting and instruction counting, and compare its results "
+        "with the host library on the same inputs. Without --replay the inputs are recorded from a closed loop "
+        "of the host solver in a random crowd.")
+    p.add_argument("dir", type=Path, help="generated solver folder")
+    p.add_argument("--cpu", choices=sorted(CPUS), default="cortex-m7",
+                   help="cortex-m4 (mps2-an386, single-precision FPU) or cortex-m7 (mps2-an500); default cortex-m7")
+    p.add_argument("--replay", type=Path, help="a replay .npz (humanmpc.replay format) instead of a recorded loop")
+    p.add_argument("--steps", type=int, default=60, help="steps of the recorded loop (default 60)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the recorded crowd (default 0)")
+    p.add_argument("--humans", type=int, help="humans in the recorded crowd (default: the solver's N_h)")
+    p.add_argument("--cold", action="store_true",
+                   help="reset the solver before every step (each step then depends on its own inputs only)")
+    p.add_argument("--timeout", type=float, default=600.0, help="QEMU time limit in seconds (default 600)")
+    p.set_defaults(func=_cmd_firmware)
+
+    p = subparsers.add_parser(
+        "firmware-report", help="footprint and instruction counts over N_h, CPUs and precisions",
+        description="Generate one solver per N_h and precision (from SPEC or the default spec), cross-compile "
+        "the footprint and replay programs for each CPU, run the replays under QEMU and print the table of "
+        "flash, RAM and instructions per RTI step (QEMU icount: instructions, not cycles).")
+    p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
+    p.add_argument("--humans", default="5,10,30", help="N_h values (default 5,10,30)")
+    p.add_argument("--cpus", default="cortex-m4,cortex-m7", help="CPUs (default cortex-m4,cortex-m7)")
+    p.add_argument("--precisions", default="double,float", help="precisions (default double,float)")
+    p.add_argument("--steps", type=int, default=20, help="replay steps per run (default 20)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the recorded crowds (default 0)")
+    p.add_argument("--out", type=Path, default=Path("out/firmware"), help="output folder (default out/firmware)")
+    p.set_defaults(func=_cmd_report)

@@ -1,0 +1,97 @@
+"""The footprint report (humanmpc-gen firmware-report): flash, RAM and instructions per RTI step over
+N_h, CPUs and precisions, the table of docs/firmware.md."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..codegen.spec import Spec, resolve_spec
+from .image import (
+    build_firmware,
+    compare_with_host,
+    host_results,
+    image_size,
+    parse_replay_output,
+    print_progress,
+    record_replay,
+    require_tools,
+    run_qemu,
+    write_firmware,
+)
+
+# -- the footprint report -----------------------------------------------------------------------
+
+
+@dataclass
+class ReportRow:
+    n_h: int
+    cpu: str
+    precision: str
+    flash: int
+    ram: int
+    text: int
+    data: int
+    bss: int
+    solver_bytes: int
+    insn_mean: float
+    insn_max: int
+    qp_iterations_mean: float  # interior-point iterations per step (steps that solved a QP)
+    steps: int
+    max_u0_diff_to_host: float
+    same_decisions_as_host: bool
+
+
+def footprint_report(base: Spec, humans: Sequence[int], cpus: Sequence[str], precisions: Sequence[str], *,
+                     steps: int, out_dir: Path, seed: int = 0,
+                     log: Callable[[str], None] | None = None) -> list[ReportRow]:
+    """Generate one package per (N_h, precision), build both programs per CPU, run the replay."""
+    import humanmpc
+
+    from ..codegen.build import build
+    from ..codegen.generate import generate
+
+    say = log or print_progress
+    quiet: Callable[[str], None] = lambda _msg: None  # noqa: E731
+    require_tools()
+    rows: list[ReportRow] = []
+    for nh in humans:
+        replay = None
+        for precision in precisions:
+            data = base.to_dict()
+            data.update(name=f"fw_h{nh}_{precision}", precision=precision)
+            data["humans"]["max"] = nh
+            spec = resolve_spec(data, "report spec")
+            d = generate(spec, out_dir / spec.name, force=True, log=quiet)
+            build(d, log=quiet)
+            host = humanmpc.load(d)
+            if replay is None:  # one replay per N_h, recorded with the first precision's host solver
+                replay = record_replay(host, steps=steps, seed=seed)
+            fw = write_firmware(d, replay)
+            host_steps = host_results(host, replay)
+            for cpu in cpus:
+                say(f"[humanmpc] N_h={nh} {precision} {cpu}")
+                size = image_size(build_firmware(fw, cpu, "footprint"))
+                run = parse_replay_output(run_qemu(build_firmware(fw, cpu, "replay"), cpu))
+                agree = compare_with_host(run, host_steps)
+                ins = run.instructions
+                qp_it = [s.qp_iterations for s in run.steps if s.qp_status >= 0]
+                rows.append(ReportRow(nh, cpu, precision, size.flash, size.ram, size.text, size.data, size.bss,
+                                      run.solver_bytes, float(ins.mean()), int(ins.max()),
+                                      float(np.mean(qp_it)) if qp_it else 0.0, len(ins),
+                                      agree.max_u0_diff, agree.same_decisions))
+    return rows
+
+
+def report_markdown(rows: Sequence[ReportRow]) -> str:
+    out = ["| N_h | CPU | precision | flash [B] (text + data) | RAM [B] (data + bss) | solver struct [B] | "
+           "instructions / RTI step, mean | max | QP iterations / step | steps | same decisions as host |",
+           "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---|"]
+    for r in rows:
+        out.append(f"| {r.n_h} | {r.cpu} | {r.precision} | {r.flash:,} | {r.ram:,} | {r.solver_bytes:,} | "
+                   f"{r.insn_mean:,.0f} | {r.insn_max:,} | {r.qp_iterations_mean:.1f} | {r.steps} | "
+                   f"{'yes' if r.same_decisions_as_host else 'no'} |")
+    return "\n".join(out) + "\n"

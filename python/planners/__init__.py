@@ -1,0 +1,3 @@
+"""Planners for the simulated world: the interface (observation in, command out), the DWB baseline, the
+global path on the static map, the generated MPC solver as a planner, and the registry of planners by name.
+"""
