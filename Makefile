@@ -2,6 +2,8 @@
 #   make test   install what is missing (apt packages as root, .venv, pip) and run the whole suite
 #   make demo   generate + build the default solver, run the crossing-group scenario with the MPC and
 #               the DWB baseline, print the metrics side by side and write the figure
+# Each target installs only what it uses: the demo the compiler and the tool's own Python
+# dependencies; the firmware target the Cortex-M cross compiler and QEMU; the tests everything.
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
@@ -9,27 +11,31 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 GEN := $(VENV)/bin/humanmpc-gen
-STAMP := $(VENV)/.installed
+STAMP_RUN := $(VENV)/.installed-run
+STAMP_TEST := $(VENV)/.installed-test
 
-# Debian packages the suite needs: compilers (gcc, clang + its sanitizer/fuzzer runtime), make and
-# CMake for the generated package, binutils for nm, valgrind, Python venv support, and Debian's Ipopt
-# (with the BLAS/LAPACK it links) for the C reference solver; the Cortex-M cross compiler, newlib and
-# QEMU for the firmware build, g++ and Eigen for the C++ face (docs/firmware.md).
-APT_PACKAGES := gcc clang libclang-rt-14-dev make cmake binutils valgrind python3-venv python3-dev \
-	coinor-libipopt-dev libblas-dev liblapack-dev \
-	gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm libeigen3-dev g++
+# Debian packages. The tool: a C compiler, make, Python venv support (and its headers, for cffi).
+APT_RUN := gcc make binutils python3-venv python3-dev
+# The Cortex-M cross compiler, newlib and QEMU (docs/firmware.md).
+APT_FIRMWARE := gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
+# The suite on top: clang (+ its sanitizer/fuzzer runtime), CMake for the generated package, valgrind,
+# Debian's Ipopt (with the BLAS/LAPACK it links) for the C reference solver, g++ and Eigen for the C++
+# face, and the firmware toolchain for the firmware tests.
+APT_TEST := $(APT_RUN) $(APT_FIRMWARE) clang libclang-rt-14-dev cmake valgrind \
+	coinor-libipopt-dev libblas-dev liblapack-dev libeigen3-dev g++
 
-.PHONY: help test demo bench firmware system-deps venv lint clean
+.PHONY: help test demo bench firmware venv venv-test lint clean
 
 help:
 	@echo "make test   - set up everything on a fresh Debian machine and run the whole test suite"
-	@echo "make demo   - generate and build the solver of the built-in default spec"
+	@echo "make demo   - generate and build the default solver, run the demo scenario (installs only what it needs)"
 	@echo "make bench  - time the RTI in random crowds; compare with acados and Ipopt (docs/benchmarks.md)"
 	@echo "make firmware - the solver on Cortex-M7 (double) and Cortex-M4 (float) under QEMU (docs/firmware.md)"
-	@echo "make lint   - ruff and mypy"
+	@echo "make lint   - ruff, mypy and the import layers"
 
-system-deps:
-	@missing=""; for p in $(APT_PACKAGES); do \
+# apt-install the packages named in $(1) that are missing (as root, or through sudo).
+define apt_install
+	@missing=""; for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
 	done; \
 	if [ -n "$$missing" ]; then \
@@ -39,17 +45,27 @@ system-deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq \
 	    --no-install-recommends $$missing >/dev/null || exit 1; \
 	fi
+endef
 
-$(STAMP): pyproject.toml
-	@echo "[setup] creating $(VENV) and installing humanmpc[test]"
+$(STAMP_RUN): pyproject.toml
+	$(call apt_install,$(APT_RUN))
+	@echo "[setup] creating $(VENV) and installing humanmpc"
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	@$(PY) -m pip install -q --upgrade pip
-	@$(PY) -m pip install -q -e '.[test]'
+	@$(PY) -m pip install -q -e .
 	@touch $@
 
-venv: system-deps $(STAMP)
+$(STAMP_TEST): $(STAMP_RUN) pyproject.toml
+	$(call apt_install,$(APT_TEST))
+	@echo "[setup] installing humanmpc[test,dev]"
+	@$(PY) -m pip install -q -e '.[test,dev]'
+	@touch $@
 
-test: venv
+venv: $(STAMP_RUN)
+
+venv-test: $(STAMP_TEST)
+
+test: venv-test
 	$(PY) -m ruff check codegen python tests
 	$(PY) -m pytest tests
 
@@ -65,15 +81,17 @@ bench: venv
 # The default spec's solver as firmware: double on a Cortex-M7, float on a Cortex-M4F, each replaying
 # a recorded crowd under QEMU and compared with the host library.
 firmware: venv
+	$(call apt_install,$(APT_FIRMWARE))
 	$(GEN) generate -o generated/paper --force
 	$(GEN) firmware generated/paper --cpu cortex-m7
 	@mkdir -p out/firmware && printf 'name: paper_float\nprecision: float\n' > out/firmware/paper_float.yaml
 	$(GEN) generate out/firmware/paper_float.yaml -o generated/paper_float --force
 	$(GEN) firmware generated/paper_float --cpu cortex-m4
 
-lint: venv
+lint: venv-test
 	$(PY) -m ruff check codegen python tests
 	$(PY) -m mypy codegen python
+	$(PY) -m pytest -q tests/test_packaging.py -k import_layer
 
 clean:
 	rm -rf build generated/*/ .pytest_cache .ruff_cache .mypy_cache .hypothesis

@@ -13,7 +13,7 @@ import jinja2
 from . import __version__
 from .casadi_emit import EmittedFunction
 from .ocp import NU, NX
-from .resources import TEMPLATES_DIR
+from .resources import templates_dir
 from .spec import IDENT_RE, Spec
 
 # What a number may look like once printed into C source: a decimal floating literal.
@@ -133,7 +133,7 @@ def template_context(spec: Spec, functions: list[EmittedFunction], real: str) ->
 
 def make_environment() -> jinja2.Environment:
     return jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(TEMPLATES_DIR)),
+        loader=jinja2.FileSystemLoader(str(templates_dir())),
         undefined=jinja2.StrictUndefined,
         autoescape=False,  # C source, not HTML
         keep_trailing_newline=True,

@@ -1,26 +1,49 @@
-"""Where the generator finds what it copies and renders: templates/ and c_runtime/."""
+"""Where the generator finds what it renders and copies: its package data, the templates
+(humanmpc.codegen.templates, the checkout's templates/) and the C runtime (humanmpc.codegen.c_runtime,
+the checkout's c_runtime/), located with importlib.resources so that a wheel and an editable checkout
+both work."""
 
 from __future__ import annotations
 
+from importlib import resources
 from pathlib import Path
 
 from . import __version__
 
-PROJECT_ROOT = Path(__file__).resolve().parent.parent
-TEMPLATES_DIR = PROJECT_ROOT / "templates"
-RUNTIME_DIR = PROJECT_ROOT / "c_runtime"
+
+def _data_dir(package: str) -> Path:
+    try:
+        root = resources.files(package)
+    except ModuleNotFoundError:
+        raise FileNotFoundError(
+            f"humanmpc {__version__}: the package data {package} is not installed: reinstall humanmpc "
+            "(pip install humanmpc, or pip install -e . from a checkout)"
+        ) from None
+    path = Path(str(root))
+    if not path.is_dir():
+        raise FileNotFoundError(
+            f"humanmpc {__version__}: {package} is at {root}, which is not a folder: install humanmpc unzipped "
+            "(pip does) so that the generator can read its templates and C runtime"
+        )
+    return path
+
+
+def templates_dir() -> Path:
+    """The Jinja2 templates of the generated package (and of the firmware and Ipopt builds)."""
+    return _data_dir("humanmpc.codegen.templates")
+
+
+def runtime_dir() -> Path:
+    return _data_dir("humanmpc.codegen.c_runtime")
 
 
 def check_resources() -> None:
-    """Fail early, with the reason, when the package is not run from a humanmpc source tree."""
-    for d in (TEMPLATES_DIR, RUNTIME_DIR):
-        if not d.is_dir():
-            raise FileNotFoundError(
-                f"humanmpc {__version__}: {d} is missing; the generator reads templates/ and c_runtime/ "
-                "from the source tree, so install it with `pip install -e .` from a checkout"
-            )
+    """Fail early, with the reason, when the generator's data are missing."""
+    for d in (templates_dir(), runtime_dir()):
+        if not any(d.iterdir()):
+            raise FileNotFoundError(f"humanmpc {__version__}: {d} is empty: reinstall humanmpc")
 
 
 def runtime_files() -> list[Path]:
     """The hand-written C runtime copied into every generated solver."""
-    return sorted(p for p in RUNTIME_DIR.iterdir() if p.suffix in (".c", ".h"))
+    return sorted(p for p in runtime_dir().iterdir() if p.suffix in (".c", ".h"))

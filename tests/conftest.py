@@ -14,6 +14,7 @@ from humanmpc.codegen.generate import generate
 from humanmpc.codegen.spec import Spec, resolve_spec
 
 QUIET: Callable[[str], None] = lambda _msg: None  # noqa: E731
+REPO_ROOT = Path(__file__).resolve().parent.parent
 
 
 def make_solver(root: Path, data: dict | None = None, *, built: bool = True) -> Path:

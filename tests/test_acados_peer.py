@@ -13,12 +13,13 @@ import numpy as np
 import pytest
 
 from humanmpc.codegen.ocp import DIST_EPS, OcpModel, smooth_distance
-from humanmpc.codegen.resources import PROJECT_ROOT
 from humanmpc.codegen.spec import resolve_spec
 from humanmpc.compare.peers.acados import PEER_SCRIPT, AcadosRun, ensure_acados_venv, find_python312, run_acados
 from humanmpc.compare.replay import Replay, synthetic_replay
 
-VENV = PROJECT_ROOT / ".venv-acados"
+from .conftest import REPO_ROOT
+
+VENV = REPO_ROOT / ".venv-acados"
 
 
 @pytest.fixture(scope="module")

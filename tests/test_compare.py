@@ -9,7 +9,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from humanmpc.codegen.resources import PROJECT_ROOT
 from humanmpc.codegen.spec import resolve_spec
 from humanmpc.compare.peers.acados import find_python312
 from humanmpc.compare.peers.ipopt import ipopt_unavailable_reason
@@ -22,6 +21,8 @@ from humanmpc.compare.report import (
     markdown_section,
 )
 
+from .conftest import REPO_ROOT
+
 
 def test_compare_writes_table_plot_and_json(tmp_path: Path) -> None:
     reason = ipopt_unavailable_reason()
@@ -29,7 +30,7 @@ def test_compare_writes_table_plot_and_json(tmp_path: Path) -> None:
         pytest.fail(f"{reason} (`make test` installs it: see APT_PACKAGES in the Makefile)")
     specs = [resolve_spec({"name": "cmp", "humans": {"max": n}, "horizon": {"N": 20, "T": 2.0}}) for n in (1, 3)]
     replays = [synthetic_replay(s, s.humans.max, 6, seed=3) for s in specs]
-    report = compare(specs, replays, tmp_path / "out", acados_venv=PROJECT_ROOT / ".venv-acados",
+    report = compare(specs, replays, tmp_path / "out", acados_venv=REPO_ROOT / ".venv-acados",
                      command="pytest", log=lambda _m: None)
     rows = report["rows"]
     assert [(r["n_humans"], r["solver"]) for r in rows] == [(n, s) for n in (1, 3) for s in SOLVERS]

@@ -44,13 +44,12 @@ import numpy as np
 from ..bindings import load
 from ..codegen.build import build, is_stale
 from ..codegen.generate import MANIFEST, generate
-from ..codegen.resources import PROJECT_ROOT
 from ..codegen.spec import Spec
 from ..solver import Solver
 from .global_path import GlobalPlanner, GridConfig, local_segment
 from .interface import Observation, PlanResult
 
-DEFAULT_SOLVER_DIR = PROJECT_ROOT / "generated" / "paper"
+DEFAULT_SOLVER_DIR = Path("generated") / "paper"  # as humanmpc-gen generate writes it, in the working folder
 GOAL_TAPER = 0.5  # v_ref <= GOAL_TAPER * distance to the goal
 LOOP_RATIO = 0.5  # a plan whose end is nearer its start than half its length is a loop
 LOOP_MIN_LENGTH = 1.0  # [m] shorter plans (stopping, waiting, arriving) are never loops

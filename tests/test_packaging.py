@@ -1,0 +1,118 @@
+"""The package as users get it: a wheel that works outside the checkout, and layers that point one way.
+
+The layers are import-linter contracts in pyproject.toml ([tool.importlinter]). The checkout keeps the
+generator in codegen/ beside the package in python/ (the product's top-level folders), which
+import-linter cannot follow, so the check runs on the tree as a wheel lays it out (humanmpc/ with
+humanmpc/codegen/ inside).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import pytest
+
+from .conftest import REPO_ROOT
+
+CONTRACTS = (
+    "The generator (humanmpc.codegen) imports nothing of humanmpc outside itself",
+    "Layers: codegen -> the solver's face -> sim -> planners -> eval | compare",
+    "No import cycles between the modules of any package",
+)
+
+
+def _clean_env(**extra: str) -> dict[str, str]:
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
+    env.update(extra)
+    return env
+
+
+def _stage_package(root: Path) -> Path:
+    """humanmpc/ as a wheel lays it out, from the checkout's python/ and codegen/."""
+    pkg = root / "humanmpc"
+    ignore = shutil.ignore_patterns("__pycache__")
+    shutil.copytree(REPO_ROOT / "python", pkg, ignore=ignore)
+    shutil.copytree(REPO_ROOT / "codegen", pkg / "codegen", ignore=ignore)
+    return pkg
+
+
+def _lint_imports(stage: Path) -> subprocess.CompletedProcess[str]:
+    exe = Path(sys.executable).parent / "lint-imports"
+    if not exe.is_file():
+        pytest.fail("lint-imports is not installed: `make test` installs import-linter (the dev extra)")
+    return subprocess.run([str(exe), "--config", str(REPO_ROOT / "pyproject.toml"), "--no-cache"], cwd=stage,
+                          env=_clean_env(PYTHONPATH=str(stage)), capture_output=True, text=True, timeout=300,
+                          check=False)
+
+
+def test_every_import_layer_contract_is_kept(tmp_path: Path) -> None:
+    stage = tmp_path / "stage"
+    _stage_package(stage)
+    proc = _lint_imports(stage)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "3 kept, 0 broken" in proc.stdout, proc.stdout
+    assert "Analyzed" in proc.stdout
+
+
+@pytest.mark.parametrize(("module", "line", "contract"), [
+    ("codegen/spec.py", "from ..solver import Solver", 0),          # the generator reaching into the rest
+    ("sim/world.py", "from ..eval import metrics", 1),               # a lower layer reaching up
+    ("planners/mpc.py", "from . import registry", 2),                # registry imports mpc: a cycle
+])
+def test_a_reverse_import_breaks_its_contract(tmp_path: Path, module: str, line: str, contract: int) -> None:
+    stage = tmp_path / "stage"
+    pkg = _stage_package(stage)
+    with (pkg / module).open("a") as f:
+        f.write(f"\n{line}  # noqa\n")
+    proc = _lint_imports(stage)
+    assert proc.returncode != 0
+    summary = " ".join(proc.stdout.split())
+    assert f"{CONTRACTS[contract]}" in summary
+    after = summary.split(CONTRACTS[contract], 1)[1]
+    assert after.find("BROKEN") != -1 and (after.find("KEPT") == -1 or after.find("BROKEN") < after.find("KEPT"))
+
+
+@pytest.mark.slow
+def test_the_wheel_installed_in_a_fresh_venv_generates_builds_loads_and_steps_a_solver(tmp_path: Path) -> None:
+    wheel_dir = tmp_path / "wheel"
+    build = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q",
+                            "-w", str(wheel_dir), str(REPO_ROOT)], cwd=tmp_path, env=_clean_env(),
+                           capture_output=True, text=True, timeout=600, check=False)
+    assert build.returncode == 0, build.stderr[-3000:]
+    wheels = list(wheel_dir.glob("humanmpc-*.whl"))
+    assert len(wheels) == 1
+    env_dir = tmp_path / "venv"
+    venv.EnvBuilder(with_pip=True, clear=True).create(env_dir)
+    python = env_dir / "bin" / "python"
+    install = subprocess.run([str(python), "-m", "pip", "install", "-q", str(wheels[0])], cwd=tmp_path,
+                             env=_clean_env(), capture_output=True, text=True, timeout=1200, check=False)
+    assert install.returncode == 0, install.stderr[-3000:]
+
+    work = tmp_path / "elsewhere"
+    work.mkdir()
+    gen = env_dir / "bin" / "humanmpc-gen"
+    (work / "tiny.yaml").write_text("name: tiny\nhorizon: {N: 10, T: 1.0}\nhumans: {max: 2}\n")
+    for cmd in (["generate", "tiny.yaml", "-o", "out/tiny"], ["build", "out/tiny"]):
+        proc = subprocess.run([str(gen), *cmd], cwd=work, env=_clean_env(), capture_output=True, text=True,
+                              timeout=600, check=False)
+        assert proc.returncode == 0, proc.stderr[-3000:]
+    script = (
+        "import numpy as np, humanmpc, pathlib\n"
+        "assert 'site-packages' in humanmpc.__file__, humanmpc.__file__\n"
+        "s = humanmpc.load('out/tiny')\n"
+        "pred = np.stack([[[3.0, 0.4 - 0.1 * n]] for n in range(11)])\n"
+        "r = s.step([0, 0, 0, 0.5], [5, 0, 0, 0.8], [[3.0, 0.4]], pred, obstacle=[4.0, 1.0])\n"
+        "assert r.status_name == 'solved' and not r.stop, r\n"
+        "assert np.all(np.isfinite(r.u0)) and r.x.shape == (11, 4)\n"
+        "print('stepped', r.u0.tolist())\n"
+    )
+    proc = subprocess.run([str(python), "-c", script], cwd=work, env=_clean_env(), capture_output=True, text=True,
+                          timeout=600, check=False)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert "stepped" in proc.stdout
+    assert REPO_ROOT.as_posix() not in proc.stdout + proc.stderr
