@@ -19,9 +19,11 @@ import casadi as ca
 from . import __version__
 from .casadi_emit import emit_model
 from .ocp import OcpModel
+from .params import PARAMS, spec_params
 from .render import render_all, template_context
 from .resources import check_resources, runtime_files
 from .spec import Spec, resolve_spec
+from .status import status_tables
 
 MANIFEST = "manifest.json"
 
@@ -44,6 +46,7 @@ def _populate(spec: Spec, out: Path) -> dict[str, object]:
     (out / "spec.yaml").write_text(
         f"# resolved spec of the humanmpc solver \"{spec.name}\" (sha256 {spec.digest()})\n" + spec.to_yaml()
     )
+    defaults = spec_params(spec)
     manifest: dict[str, object] = {
         "generator": "humanmpc",
         "generator_version": __version__,
@@ -70,6 +73,11 @@ def _populate(spec: Spec, out: Path) -> dict[str, object]:
             for ef in emitted
         ],
         "library": f"build/lib{spec.name}.so",
+        # the runtime parameters' table (humanmpc.codegen.params) with this solver's defaults: what
+        # a binding checks set_params against
+        "params": [{**p.manifest_row(), "default": defaults[p.name]} for p in PARAMS],
+        # status codes and stop reasons (runtime/hm_status.h): value, name, message
+        "statuses": {key: [[c.value, c.name, c.message] for c in rows] for key, rows in status_tables().items()},
     }
     (out / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n")
     return manifest

@@ -44,6 +44,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import params as params_table
 from .casadi_emit import make_helpers_static, make_parameters_used
 from .ocp import NU, NX, collision_potential, rk4_step, smooth_distance
 from .spec import Spec
@@ -53,41 +54,14 @@ FloatArray = NDArray[np.float64]
 INF = 1e20  # what "no bound" is written as; Ipopt's nlp_lower/upper_bound_inf default is -/+1e19
 
 # The runtime parameters that define the problem (names as in <name>_params), with their sizes.
-PROBLEM_PARAMS: tuple[tuple[str, int], ...] = (
-    ("w_goal", 4),
-    ("w_goal_terminal", 4),
-    ("w_control", 2),
-    ("q", 1),
-    ("d_th", 1),
-    ("kappa", 1),
-    ("d_h", 1),
-    ("d_s", 1),
-    ("slack_l1", 1),
-    ("slack_l2", 1),
-    ("v_bounds", 2),
-    ("a_bounds", 2),
-    ("omega_bounds", 2),
-)
+# (name, size) of the problem parameters: the rows of the parameter table that define the OCP.
+PROBLEM_PARAMS: tuple[tuple[str, int], ...] = tuple((p.name, p.size) for p in params_table.PROBLEM_PARAMS)
 
 
 def problem_params(spec: Spec) -> dict[str, float | tuple[float, ...]]:
     """The spec's values of the problem parameters (the defaults of the solver's runtime parameters)."""
-    w, cc, ob, b = spec.weights, spec.collision_cost, spec.obstacle, spec.bounds
-    return {
-        "w_goal": tuple(w.goal),
-        "w_goal_terminal": tuple(w.goal_terminal),
-        "w_control": tuple(w.control),
-        "q": cc.q,
-        "d_th": cc.d_th,
-        "kappa": cc.kappa,
-        "d_h": spec.humans.d_h,
-        "d_s": ob.d_s,
-        "slack_l1": ob.slack_l1,
-        "slack_l2": ob.slack_l2,
-        "v_bounds": tuple(b.v),
-        "a_bounds": tuple(b.a),
-        "omega_bounds": tuple(b.omega),
-    }
+    values = params_table.spec_params(spec)
+    return {name: values[name] for name, _ in PROBLEM_PARAMS}
 
 
 def check_problem_params(params: Mapping[str, Any]) -> dict[str, FloatArray]:

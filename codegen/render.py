@@ -13,8 +13,10 @@ import jinja2
 from . import __version__
 from .casadi_emit import EmittedFunction
 from .ocp import NU, NX
+from .params import PARAMS, Param, Range, spec_params
 from .resources import templates_dir
 from .spec import IDENT_RE, Spec
+from .status import status_tables
 
 # What a number may look like once printed into C source: a decimal floating literal.
 _C_FLOAT = re.compile(r"^-?[0-9]+(\.[0-9]*)?(e[-+]?[0-9]+)?$")
@@ -51,42 +53,60 @@ def c_identifier(name: str) -> str:
 
 @dataclass(frozen=True)
 class RuntimeParam:
-    """A field of <name>_params: set at run time, defaulting to the spec's value."""
+    """A field of <name>_params as the templates print it: from its row of the parameter table."""
 
     c_name: str
+    ctype: str                      # "real" or "int"
     doc: str
     default: tuple[str, ...] | str  # C literals
     size: int
+    checks: tuple[str, ...]         # C expressions over p, all true when the rule holds (NaN fails them)
+    rule: str                       # the rule in words, a C string literal's contents
 
 
-def runtime_params(spec: Spec) -> list[RuntimeParam]:
-    def vec(c_name: str, doc: str, values: tuple[float, ...]) -> RuntimeParam:
-        return RuntimeParam(c_name, doc, tuple(c_float(v) for v in values), len(values))
+def _range_test(x: str, r: Range, real: str) -> str:
+    lo = f"({real}){c_float(r.lo)} {'<' if r.lo_open else '<='} {x}"
+    hi = f"{x} {'<' if r.hi_open else '<='} ({real}){c_float(r.hi)}"
+    return f"{lo} && {hi}"
 
-    def one(c_name: str, doc: str, value: float) -> RuntimeParam:
-        return RuntimeParam(c_name, doc, c_float(value), 1)
 
-    w, cc, ob, b, s = spec.weights, spec.collision_cost, spec.obstacle, spec.bounds, spec.solver
-    return [
-        vec("w_goal", "stage weights on x - g", w.goal),
-        vec("w_goal_terminal", "terminal weights on x_N - g", w.goal_terminal),
-        vec("w_control", "stage weights on u", w.control),
-        one("q", "collision potential height", cc.q),
-        one("d_th", "collision potential threshold distance [m]", cc.d_th),
-        one("kappa", "collision potential steepness [1/m]", cc.kappa),
-        one("d_h", "hard distance to humans' current positions [m]", spec.humans.d_h),
-        one("human_slack_l1", "exact-penalty weight on the human rows", spec.humans.slack_l1),
-        one("human_slack_l2", "L2 penalty on the human-row slack", spec.humans.slack_l2),
-        one("d_s", "soft distance to the closest obstacle [m]", ob.d_s),
-        one("slack_l1", "L1 penalty on the obstacle slack", ob.slack_l1),
-        one("slack_l2", "L2 penalty on the obstacle slack", ob.slack_l2),
-        vec("v_bounds", "[min, max] forward speed [m/s]", b.v),
-        vec("a_bounds", "[min, max] acceleration [m/s^2]", b.a),
-        vec("omega_bounds", "[min, max] turn rate [rad/s]", b.omega),
-        one("regularization", "Levenberg-Marquardt term on the QP Hessian", s.regularization),
-        one("qp_tol", "QP convergence tolerance", s.qp_tol),
-        one("deadline_ms", "time allowed for one solver step [ms]", spec.monitor.deadline_ms),
-    ]
+def _check_exprs(p: Param, real: str) -> tuple[str, ...]:
+    f = f"p->{c_identifier(p.name)}"
+    if p.kind == "flag":
+        return (f"{f} == 0 || {f} == 1",)
+    if p.kind == "integer":
+        assert p.valid is not None
+        return (f"{int(p.valid.lo)} {'<' if p.valid.lo_open else '<='} {f} && {f} {'<' if p.valid.hi_open else '<='} "
+                f"{int(p.valid.hi)}",)
+    if p.kind == "interval":
+        assert p.lower is not None and p.upper is not None
+        return (_range_test(f + "[0]", p.lower, real), _range_test(f + "[1]", p.upper, real), f"{f}[0] < {f}[1]")
+    assert p.valid is not None
+    entries = [f"{f}[{i}]" for i in range(p.size)] if p.size > 1 else [f]
+    return tuple(_range_test(e, p.valid, real) for e in entries)
+
+
+def _c_string(text: str) -> str:
+    if not re.fullmatch(r"[ -~]*", text) or '"' in text or "\\" in text or "*/" in text:
+        raise ValueError(f"{text!r} cannot be printed into a C string literal")
+    return text
+
+
+def runtime_params(spec: Spec, real: str) -> list[RuntimeParam]:
+    """The rows of the parameter table with the spec's values as defaults."""
+    values = spec_params(spec)
+    out = []
+    for p in PARAMS:
+        v = values[p.name]
+        if p.ctype == "int":
+            default: tuple[str, ...] | str = str(int(v))
+        elif p.size > 1:
+            default = tuple(c_float(x) for x in v)
+        else:
+            default = c_float(v)
+        out.append(RuntimeParam(c_identifier(p.name), p.ctype, _c_string(p.described), default, p.size,
+                                _check_exprs(p, real), _c_string(f"{p.name} must be {p.rule}")))
+    return out
 
 
 def _function_context(prefix: str, ef: EmittedFunction) -> dict[str, Any]:
@@ -122,11 +142,8 @@ def template_context(spec: Spec, functions: list[EmittedFunction], real: str) ->
         "NH_ALLOC": max(1, int(spec.humans.max)),  # C has no zero-length arrays
         "runtime_sources": RUNTIME_SOURCES,
         "dt": c_float(spec.dt),
-        "params": runtime_params(spec),
-        "qp_max_iter": int(spec.solver.qp_max_iter),
-        "line_search": 1 if spec.solver.line_search else 0,
-        "row_screening": 1 if spec.solver.row_screening else 0,
-        "exact_hessian": 1 if spec.solver.hessian == "exact" else 0,
+        "statuses": status_tables(),
+        "params": runtime_params(spec, {"double": "double", "float": "float"}[real]),
         "functions": [_function_context(name, ef) for ef in functions],
     }
 

@@ -22,6 +22,8 @@ from typing import Any, cast
 
 import yaml
 
+from .params import BY_KEY, Param
+
 
 class SpecError(ValueError):
     """A spec that cannot be used; ``problems`` holds one line per broken rule."""
@@ -70,6 +72,7 @@ class Rule:
     le: float | None = None
     length: int | None = None
     choices: tuple[str, ...] = ()
+    param: Param | None = None  # kind "param": a runtime parameter, checked by its row of the table
 
     def check(self, path: str, value: Any) -> tuple[Any, list[str]]:
         """Return the normalised value and the problems found (empty when valid)."""
@@ -122,6 +125,13 @@ class Rule:
         if not problems and not lo < hi:
             problems.append(f"{path}: {list(value)!r} is reversed or empty: lower bound must be < upper bound")
         return (lo, hi), problems
+
+    def _check_param(self, path: str, value: Any) -> tuple[Any, list[str]]:
+        assert self.param is not None
+        checked, why = self.param.check(value)
+        if why is not None:
+            return None, [f"{path}: {why}: must be {self.param.rule}"]
+        return checked, []
 
     # -- strings --------------------------------------------------------------------------------
     def _check_boolean(self, path: str, value: Any) -> tuple[Any, list[str]]:
@@ -178,6 +188,16 @@ def choice(default: str, doc: str, choices: tuple[str, ...]) -> Any:
     return _field(default, Rule("choice", doc, choices=choices))
 
 
+def param(key: str) -> Any:
+    """A key whose value is a runtime parameter's default: rule, default and meaning from its row of
+    the parameter table (humanmpc.codegen.params)."""
+    p = BY_KEY[key]
+    if p.kind == "flag":  # a boolean or a choice in the spec, 0 or 1 in C
+        rule = Rule("choice", p.described, choices=p.spec_choices) if p.spec_choices else Rule("boolean", p.described)
+        return _field(p.default, rule)
+    return _field(p.default, Rule("param", p.described, param=p))
+
+
 # --------------------------------------------------------------------------------------------
 # The schema (defaults: the paper's experiment, section "Parameters and Model")
 # --------------------------------------------------------------------------------------------
@@ -198,66 +218,52 @@ class Integrator:
 @dataclass(frozen=True)
 class Humans:
     max: int = integer(10, "N_h: how many humans the solver handles (a fixed size)", ge=0, le=200)
-    d_h: float = number(0.5, "hard minimum distance to a human's current position [m]", ge=0.0, le=100.0)
-    slack_l1: float = number(
-        1e4, "exact-penalty weight on the human rows: must exceed their multipliers", ge=0.0, le=1e9
-    )
-    slack_l2: float = number(100.0, "L2 penalty on the human-row slack (0.5*l2*s^2)", ge=0.0, le=1e9)
+    d_h: float = param("humans.d_h")
+    slack_l1: float = param("humans.slack_l1")
+    slack_l2: float = param("humans.slack_l2")
 
 
 @dataclass(frozen=True)
 class CollisionCost:
-    q: float = number(2.0, "height of the collision potential", ge=0.0, le=1e6)
-    d_th: float = number(1.0, "distance at which the potential is q/2 [m]", ge=0.0, le=100.0)
-    kappa: float = number(5.0, "steepness of the potential [1/m]", gt=0.0, le=1e3)
+    q: float = param("collision_cost.q")
+    d_th: float = param("collision_cost.d_th")
+    kappa: float = param("collision_cost.kappa")
 
 
 @dataclass(frozen=True)
 class Obstacle:
-    d_s: float = number(0.5, "soft minimum distance to the closest obstacle [m]", ge=0.0, le=100.0)
-    slack_l1: float = number(100.0, "L1 penalty on the obstacle slack", ge=0.0, le=1e9)
-    slack_l2: float = number(100.0, "L2 penalty on the obstacle slack (0.5*l2*s^2)", ge=0.0, le=1e9)
+    d_s: float = param("obstacle.d_s")
+    slack_l1: float = param("obstacle.slack_l1")
+    slack_l2: float = param("obstacle.slack_l2")
 
 
 @dataclass(frozen=True)
 class Weights:
-    goal: tuple[float, ...] = vector((0.5, 0.5, 0.0, 250.0), "stage weights on x - g", ge=0.0, le=1e9)
-    goal_terminal: tuple[float, ...] = vector(
-        (40.0, 40.0, 2.0, 0.0), "terminal weights on x_N - g", ge=0.0, le=1e9
-    )
-    control: tuple[float, ...] = vector((0.0, 0.0), "stage weights on u = [a, omega]", ge=0.0, le=1e9)
+    goal: tuple[float, ...] = param("weights.goal")
+    goal_terminal: tuple[float, ...] = param("weights.goal_terminal")
+    control: tuple[float, ...] = param("weights.control")
 
 
 @dataclass(frozen=True)
 class Bounds:
-    v: tuple[float, float] = interval((0.0, 1.0), "forward speed [m/s]")
-    a: tuple[float, float] = interval((-1.0, 1.0), "acceleration [m/s^2]")
-    omega: tuple[float, float] = interval((-1.5, 1.5), "turn rate [rad/s]")
+    v: tuple[float, float] = param("bounds.v")
+    a: tuple[float, float] = param("bounds.a")
+    omega: tuple[float, float] = param("bounds.omega")
 
 
 @dataclass(frozen=True)
 class Solver:
-    regularization: float = number(1e-6, "Levenberg-Marquardt term added to the QP Hessian", ge=0.0, le=1e3)
-    qp_max_iter: int = integer(50, "interior-point iteration limit per QP", ge=1, le=1000)
-    qp_tol: float = number(1e-6, "QP convergence tolerance", gt=0.0, le=1.0)
-    line_search: bool = boolean(
-        False, "RTI: damp the QP step by a backtracking line search on the l1 merit (false: full step)"
-    )
-    row_screening: bool = boolean(
-        True, "leave distance rows far from binding out of each QP and check them at its solution (re-solving "
-        "with any that are violated): the same solution, at the cost of the rows that matter"
-    )
-    hessian: str = choice(
-        "gauss_newton",
-        "RTI Hessian: gauss_newton (acados' default), or exact: the Hessian of the Lagrangian at the shifted "
-        "multipliers, projected per stage onto the PSD cone (no omega chatter when the goal is far)",
-        ("gauss_newton", "exact"),
-    )
+    regularization: float = param("solver.regularization")
+    qp_max_iter: int = param("solver.qp_max_iter")
+    qp_tol: float = param("solver.qp_tol")
+    line_search: bool = param("solver.line_search")
+    row_screening: bool = param("solver.row_screening")
+    hessian: str = param("solver.hessian")
 
 
 @dataclass(frozen=True)
 class Monitor:
-    deadline_ms: float = number(20.0, "time allowed for one solver step [ms]", gt=0.0, le=1e5)
+    deadline_ms: float = param("monitor.deadline_ms")
 
 
 @dataclass(frozen=True)
@@ -360,15 +366,6 @@ def _cross_checks(spec: Spec) -> list[str]:
             f"residuals stop at their rounding floor and the QPs fail; with precision: float set "
             f"solver.qp_tol >= {floor:g}"
         )
-    lo, hi = spec.bounds.v
-    if lo > 0.0:
-        problems.append(f"bounds.v: {list(spec.bounds.v)!r} excludes standstill: the lower bound must be <= 0")
-    if hi <= 0.0:
-        problems.append(f"bounds.v: {list(spec.bounds.v)!r} allows no forward motion: the upper bound must be > 0")
-    for key in ("a", "omega"):
-        lo, hi = getattr(spec.bounds, key)
-        if not lo <= 0.0 <= hi:
-            problems.append(f"bounds.{key}: {[lo, hi]!r} must contain 0 (the robot must be able to hold)")
     return problems
 
 

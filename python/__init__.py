@@ -7,6 +7,8 @@
 
 from .bindings import Dims, LoadError, load
 from .codegen import __version__
-from .solver import Solver, StepResult
+from .results import StepResult
+from .solver import Solver
+from .status import QpStatus, Status, StopReason
 
-__all__ = ["Dims", "LoadError", "Solver", "StepResult", "__version__", "load"]
+__all__ = ["Dims", "LoadError", "QpStatus", "Solver", "Status", "StepResult", "StopReason", "__version__", "load"]

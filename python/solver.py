@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .codegen.params import Param
 from .results import StepResult
 from .steplog import StepLog
 
@@ -48,7 +49,8 @@ def _view(ffi: Any, cdata: Any, shape: tuple[int, ...], dtype: Any = np.float64)
 class Solver:
     """A generated solver, loaded with ``humanmpc.load(DIR)``."""
 
-    def __init__(self, name: str, dims: Any, ffi: Any, lib: Any, model: Any, path: Any, spec_hash: str) -> None:
+    def __init__(self, name: str, dims: Any, ffi: Any, lib: Any, model: Any, path: Any, spec_hash: str,
+                 params_table: tuple[Param, ...]) -> None:
         self.name = name
         self.dims = dims
         self.model = model
@@ -88,6 +90,13 @@ class Solver:
         self._out_buffer = ffi.buffer(self._out)
         self._out_dtype = record_dtype(ffi, f"{name}_output")
         self._param_fields = {f: t.type for f, t in ffi.typeof(f"{name}_params").fields}
+        self._param_rows = {p.name: p for p in params_table}
+        if list(self._param_rows) != list(self._param_fields):
+            raise ValueError(f"the manifest's parameter table {list(self._param_rows)} does not match the library's "
+                             f"params struct {list(self._param_fields)}")
+        self._params_check = fn("params_check")
+        self._params_rule = fn("params_rule")
+        self._params_staged = ffi.new(f"{name}_params *")
         self.log: StepLog | None = None
 
     def start_log(self, capacity: int = 10000) -> StepLog:
@@ -203,39 +212,34 @@ class Solver:
     def set_params(self, **values: Any) -> None:
         """Change runtime parameters, e.g. set_params(q=3.0, w_goal=[1, 1, 0, 100]).
 
-        Every value is checked (name, size, finite, sign) before any is written.
+        Every value is checked against its row of the parameter table (type, size, range: the rules of
+        the spec and of the C check, named in the same words) before any is written; a ValueError
+        lists every value that breaks its rule, and nothing is changed.
         """
+        problems: list[str] = []
         staged: list[tuple[str, Any]] = []
         for key, value in values.items():
-            if key not in self._param_fields:
-                raise KeyError(f"unknown parameter {key!r}; parameters are {', '.join(self._param_fields)}")
-            ftype = self._param_fields[key]
-            if key == "qp_max_iter":
-                if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 1000:
-                    raise ValueError(f"qp_max_iter must be an integer in [1, 1000], got {value!r}")
-                staged.append((key, value))
+            row = self._param_rows.get(key)
+            if row is None:
+                problems.append(f"{key}: unknown parameter; parameters are {', '.join(self._param_rows)}")
                 continue
-            if key in ("line_search", "row_screening", "exact_hessian"):
-                if not isinstance(value, bool) and value not in (0, 1):
-                    raise ValueError(f"{key} must be true or false, got {value!r}")
-                staged.append((key, int(value)))
-                continue
-            arr = np.asarray(value, dtype=np.float64)
-            size = ftype.length if ftype.kind == "array" else 1
-            if arr.size != size:
-                raise ValueError(f"parameter {key} takes {size} value(s), got {arr.size}")
-            if not np.all(np.isfinite(arr)):
-                raise ValueError(f"parameter {key} must be finite, got {value!r}")
-            if key.endswith("_bounds"):
-                if not arr[0] < arr[1]:
-                    raise ValueError(f"parameter {key} must be [lower, upper] with lower < upper, got {value!r}")
+            checked, why = row.check(value)
+            if why is not None:
+                problems.append(f"{key}: {why}: {row.name} must be {row.rule}")
             else:
-                strict = key in ("kappa", "qp_tol", "deadline_ms")
-                if np.any(arr < 0) or (strict and np.any(arr <= 0)):
-                    raise ValueError(f"parameter {key} must be {'> 0' if strict else '>= 0'}, got {value!r}")
-            staged.append((key, arr.tolist() if size > 1 else float(arr.reshape(-1)[0])))
+                staged.append((key, list(checked) if row.size > 1 else checked))
+        if problems:
+            raise ValueError("invalid runtime parameter(s), none changed:\n  - " + "\n  - ".join(problems))
+        # The C check has the last word (the same table): a combination it refuses changes nothing.
+        ffi = self._ffi
+        ffi.memmove(self._params_staged, self._params, ffi.sizeof(f"{self.name}_params"))
         for key, v in staged:
-            setattr(self._params, key, v)
+            setattr(self._params_staged, key, v)
+        broken = int(self._params_check(self._params_staged))
+        if broken:
+            rule = ffi.string(self._params_rule(broken)).decode()
+            raise ValueError(f"invalid runtime parameter(s), none changed: {rule}")
+        ffi.memmove(self._params, self._params_staged, ffi.sizeof(f"{self.name}_params"))
 
     def status_message(self, status: int) -> str:
         return str(self._ffi.string(self._status_message(status)).decode())

@@ -1,18 +1,37 @@
-"""The solver's status codes, QP status codes and stop reasons, by name."""
+"""The solver's status codes, QP status codes and stop reasons as Python enums.
+
+From their single source, the C runtime's table (runtime/hm_status.h, read by
+humanmpc.codegen.status): the same values and messages as the generated C, member names in upper
+case (``StopReason.HUMAN_TOO_CLOSE``), ``.message`` the C message.
+"""
 
 from __future__ import annotations
 
-STATUS_NAMES = {0: "solved", 1: "max_iter", 2: "qp_failed", 3: "skipped"}
-STOP_REASONS = {
-    0: None,
-    1: "invalid_input",
-    2: "invalid_params",
-    3: "deadline",
-    4: "qp_failed",
-    5: "nonfinite",
-    6: "human_too_close",
-    7: "unsafe_plan",
-}
-QP_STATUS_NAMES = {
-    -1: "not_run", 0: "solved", 1: "max_iter", 2: "infeasible", 3: "numerical", 4: "nonfinite", 5: "timeout",
-}
+from enum import IntEnum
+
+from .codegen.status import status_tables
+
+
+class _Coded(IntEnum):
+    @property
+    def message(self) -> str:
+        return _MESSAGES[type(self).__name__][int(self)]
+
+
+_MESSAGES: dict[str, dict[int, str]] = {}
+
+
+def _enum(class_name: str, key: str) -> type[_Coded]:
+    rows = status_tables()[key]
+    _MESSAGES[class_name] = {r.value: r.message for r in rows}
+    return _Coded(class_name, [(r.name.upper(), r.value) for r in rows])  # type: ignore[return-value]
+
+
+QpStatus = _enum("QpStatus", "qp_status")
+Status = _enum("Status", "status")
+StopReason = _enum("StopReason", "stop_reason")
+
+# Lower-case names by value, as StepResult and the logs print them (no stop: None).
+STATUS_NAMES: dict[int, str] = {int(s): s.name.lower() for s in Status}
+QP_STATUS_NAMES: dict[int, str] = {int(s): s.name.lower() for s in QpStatus}
+STOP_REASONS: dict[int, str | None] = {int(s): (None if s == 0 else s.name.lower()) for s in StopReason}

@@ -10,11 +10,9 @@ from pathlib import Path
 from typing import Any
 
 from ..codegen.spec import SpecError, load_spec
+from ..status import STOP_REASONS
 from .image import CPUS, FirmwareError, image_size, load_replay_file, run_firmware
 from .report import footprint_report, report_markdown
-
-STOP_NAMES = {0: "-", 1: "invalid_input", 2: "invalid_params", 3: "deadline", 4: "qp_failed", 5: "nonfinite",
-              6: "human_too_close", 7: "unsafe_plan"}
 
 
 def _cmd_firmware(args: argparse.Namespace) -> int:
@@ -28,7 +26,8 @@ def _cmd_firmware(args: argparse.Namespace) -> int:
           f"sizeof({run.name}_solver) = {run.solver_bytes} B")
     print(f"{'t':>4} {'status':>6} {'stop':>16} {'qp_it':>5} {'a':>10} {'omega':>10} {'instructions':>13}")
     for s in run.steps:
-        print(f"{s.t:>4} {s.status:>6} {STOP_NAMES.get(s.stop_reason, s.stop_reason)!s:>16} {s.qp_iterations:>5} "
+        stop = STOP_REASONS.get(s.stop_reason, str(s.stop_reason)) or "-"
+        print(f"{s.t:>4} {s.status:>6} {stop:>16} {s.qp_iterations:>5} "
               f"{s.u0[0]:>10.6f} {s.u0[1]:>10.6f} {s.instructions:>13,}")
     ins = run.instructions
     size = image_size(elf)

@@ -1,0 +1,251 @@
+"""The runtime parameters: one table, the single source of their contract.
+
+Every field of ``<name>_params`` is a row of ``PARAMS``: its name, the spec key whose value is its
+default, its shape, unit, valid range and meaning. Derived from this table, and from nothing else:
+
+- the spec schema's rules and defaults for those keys (``humanmpc.codegen.spec``);
+- the C params struct, ``<name>_params_default`` and the C checks ``<name>_params_check`` /
+  ``<name>_params_rule`` (``templates/``), which the safety monitor applies before every step;
+- the manifest's ``params`` table, from which the Python binding's ``set_params`` checks its values;
+- the problem parameters of the Ipopt reference (rows with ``problem=True``).
+
+A broken rule is reported with the same text everywhere: ``Param.rule``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+# Kinds of parameter: a real number, a vector of reals, an interval [lower, upper] of reals, an
+# integer, a 0/1 flag.
+KINDS = ("real", "vector", "interval", "integer", "flag")
+
+
+@dataclass(frozen=True)
+class Range:
+    """lo <= x <= hi, or lo < x (lo_open) / x < hi (hi_open)."""
+
+    lo: float
+    hi: float
+    lo_open: bool = False
+    hi_open: bool = False
+
+    def holds(self, x: float) -> bool:
+        above = x > self.lo if self.lo_open else x >= self.lo
+        below = x < self.hi if self.hi_open else x <= self.hi
+        return bool(above and below)  # False for NaN
+
+    def text(self, var: str) -> str:
+        lo = f"{_num(self.lo)} {'<' if self.lo_open else '<='} "
+        hi = f" {'<' if self.hi_open else '<='} {_num(self.hi)}"
+        return f"{lo}{var}{hi}"
+
+
+def _num(x: float) -> str:
+    return f"{x:g}" if not float(x).is_integer() or abs(x) >= 1e6 else str(int(x))
+
+
+@dataclass(frozen=True)
+class Param:
+    name: str                  # field of <name>_params, keyword of Solver.set_params
+    key: str                   # spec key path whose value is the default
+    kind: str                  # one of KINDS
+    default: Any               # the paper's value (the spec's default)
+    doc: str
+    unit: str = ""
+    size: int = 1              # entries in C (vectors, intervals)
+    valid: Range | None = None  # every entry (real, vector, integer)
+    lower: Range | None = None  # interval: the lower bound
+    upper: Range | None = None  # interval: the upper bound
+    problem: bool = False      # part of the optimal control problem itself (the Ipopt reference's parameters)
+    spec_choices: tuple[str, ...] = field(default=())  # flag set in the spec by a choice: its index is the flag
+
+    @property
+    def described(self) -> str:
+        """The meaning with its unit, for listings."""
+        return f"{self.doc} [{self.unit}]" if self.unit else self.doc
+
+    @property
+    def ctype(self) -> str:
+        return "int" if self.kind in ("integer", "flag") else "real"
+
+    @property
+    def rule(self) -> str:
+        """The rule in words: the same text in the spec's, C's and Python's messages ('must be ...')."""
+        if self.kind == "real":
+            assert self.valid is not None
+            return f"a number with {self.valid.text(self.name)}"
+        if self.kind == "vector":
+            assert self.valid is not None
+            return f"{self.size} numbers, each with {self.valid.text('w')}"
+        if self.kind == "interval":
+            assert self.lower is not None and self.upper is not None
+            return (f"[lower, upper] with {self.lower.text('lower')}, {self.upper.text('upper')} "
+                    "and lower < upper")
+        if self.kind == "integer":
+            assert self.valid is not None
+            return f"an integer with {self.valid.text(self.name)}"
+        return "0 or 1 (false or true)"
+
+    def spec_value(self, value: Any) -> Any:
+        """The parameter's value for a spec value (a choice becomes its index, a boolean 0 or 1)."""
+        if self.spec_choices:
+            return self.spec_choices.index(value)
+        if self.kind == "flag":
+            return int(bool(value))
+        return value
+
+    def check(self, value: Any) -> tuple[Any, str | None]:
+        """(the value as C stores it, None) when it keeps the rule, else (None, why not)."""
+        if self.ctype == "real":
+            nums = _reals(value, self.size)
+            if nums is None:
+                return None, f"{value!r} has the wrong type or size"
+            if not all(math.isfinite(x) for x in nums):
+                return None, f"{value!r} is not finite"
+            if self.kind == "interval":
+                assert self.lower is not None and self.upper is not None
+                ok = self.lower.holds(nums[0]) and self.upper.holds(nums[1]) and nums[0] < nums[1]
+            else:
+                assert self.valid is not None
+                ok = all(self.valid.holds(x) for x in nums)
+            if not ok:
+                return None, f"{value!r} is out of range"
+            return (tuple(nums) if self.size > 1 else nums[0]), None
+        if isinstance(value, (bool, np.bool_)):
+            return (int(value), None) if self.kind == "flag" else (None, f"{value!r} has the wrong type")
+        if not isinstance(value, (int, np.integer)):
+            return None, f"{value!r} has the wrong type"
+        i = int(value)
+        ok = i in (0, 1) if self.kind == "flag" else self.valid is not None and self.valid.holds(i)
+        return (i, None) if ok else (None, f"{value!r} is out of range")
+
+    @classmethod
+    def from_manifest_row(cls, row: Mapping[str, Any]) -> Param:
+        """The row as a generated package's manifest records it (what a binding checks against)."""
+        ranges = {part: Range(float(r[0]), float(r[1]), bool(r[2]), bool(r[3]))
+                  for part in ("valid", "lower", "upper") if (r := row.get(part)) is not None}
+        if row["kind"] not in KINDS:
+            raise ValueError(f"unknown parameter kind {row['kind']!r} in the manifest")
+        return cls(name=str(row["name"]), key=str(row["key"]), kind=str(row["kind"]), default=row.get("default"),
+                   doc=str(row["doc"]), unit=str(row.get("unit", "")), size=int(row["size"]), **ranges)
+
+    def manifest_row(self) -> dict[str, Any]:
+        row: dict[str, Any] = {"name": self.name, "key": self.key, "kind": self.kind, "size": self.size,
+                               "unit": self.unit, "doc": self.doc, "rule": self.rule}
+        for part in ("valid", "lower", "upper"):
+            r = getattr(self, part)
+            if r is not None:
+                row[part] = [r.lo, r.hi, r.lo_open, r.hi_open]
+        return row
+
+
+def _reals(value: Any, size: int) -> list[float] | None:
+    """The entries of a real or a sequence of ``size`` reals (numbers, not strings or booleans), or None."""
+    if size == 1:
+        items = [value]
+    elif isinstance(value, (list, tuple)):
+        items = list(value)
+    elif isinstance(value, np.ndarray) and value.ndim == 1:
+        items = value.tolist()
+    else:
+        return None
+    if len(items) != size:
+        return None
+    if any(isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer, np.floating)) for v in items):
+        return None
+    return [float(v) for v in items]
+
+
+# Caps: far beyond any robot, but finite, so that no value overflows the solver's arithmetic.
+_WEIGHT = Range(0.0, 1e9)
+_DIST = Range(0.0, 100.0)
+
+PARAMS: tuple[Param, ...] = (
+    Param("w_goal", "weights.goal", "vector", (0.5, 0.5, 0.0, 250.0), "stage weights on x - g", size=4,
+          valid=_WEIGHT, problem=True),
+    Param("w_goal_terminal", "weights.goal_terminal", "vector", (40.0, 40.0, 2.0, 0.0),
+          "terminal weights on x_N - g", size=4, valid=_WEIGHT, problem=True),
+    Param("w_control", "weights.control", "vector", (0.0, 0.0), "stage weights on u = [a, omega]", size=2,
+          valid=_WEIGHT, problem=True),
+    Param("q", "collision_cost.q", "real", 2.0, "height of the collision potential", valid=Range(0.0, 1e6),
+          problem=True),
+    Param("d_th", "collision_cost.d_th", "real", 1.0, "distance at which the potential is q/2", unit="m",
+          valid=_DIST, problem=True),
+    Param("kappa", "collision_cost.kappa", "real", 5.0, "steepness of the potential", unit="1/m",
+          valid=Range(0.0, 1e3, lo_open=True), problem=True),
+    Param("d_h", "humans.d_h", "real", 0.5, "hard minimum distance to a human's current position", unit="m",
+          valid=_DIST, problem=True),
+    Param("human_slack_l1", "humans.slack_l1", "real", 1e4,
+          "exact-penalty weight on the human rows: must exceed their multipliers", valid=_WEIGHT),
+    Param("human_slack_l2", "humans.slack_l2", "real", 100.0, "L2 penalty on the human-row slack (0.5*l2*s^2)",
+          valid=_WEIGHT),
+    Param("d_s", "obstacle.d_s", "real", 0.5, "soft minimum distance to the closest obstacle", unit="m",
+          valid=_DIST, problem=True),
+    Param("slack_l1", "obstacle.slack_l1", "real", 100.0, "L1 penalty on the obstacle slack", valid=_WEIGHT,
+          problem=True),
+    Param("slack_l2", "obstacle.slack_l2", "real", 100.0, "L2 penalty on the obstacle slack (0.5*l2*s^2)",
+          valid=_WEIGHT, problem=True),
+    # The bounds must admit the protective stop: standstill (v = 0), braking (a < 0) and no turning.
+    Param("v_bounds", "bounds.v", "interval", (0.0, 1.0), "forward speed", unit="m/s", size=2,
+          lower=Range(-100.0, 0.0), upper=Range(0.0, 100.0, lo_open=True), problem=True),
+    Param("a_bounds", "bounds.a", "interval", (-1.0, 1.0), "acceleration", unit="m/s^2", size=2,
+          lower=Range(-100.0, 0.0, hi_open=True), upper=Range(0.0, 100.0, lo_open=True), problem=True),
+    Param("omega_bounds", "bounds.omega", "interval", (-1.5, 1.5), "turn rate", unit="rad/s", size=2,
+          lower=Range(-100.0, 0.0), upper=Range(0.0, 100.0), problem=True),
+    Param("regularization", "solver.regularization", "real", 1e-6,
+          "Levenberg-Marquardt term added to the QP Hessian", valid=Range(0.0, 1e3)),
+    Param("qp_tol", "solver.qp_tol", "real", 1e-6, "QP convergence tolerance", valid=Range(0.0, 1.0, lo_open=True)),
+    Param("deadline_ms", "monitor.deadline_ms", "real", 20.0, "time allowed for one solver step", unit="ms",
+          valid=Range(0.0, 1e5, lo_open=True)),
+    Param("qp_max_iter", "solver.qp_max_iter", "integer", 50, "interior-point iteration limit per QP",
+          valid=Range(1, 1000)),
+    Param("line_search", "solver.line_search", "flag", False,
+          "RTI: damp the QP step by a backtracking line search on the l1 merit (false: full step)"),
+    Param("row_screening", "solver.row_screening", "flag", True,
+          "leave distance rows far from binding out of each QP and check them at its solution (re-solving "
+          "with any that are violated): the same solution, at the cost of the rows that matter"),
+    Param("exact_hessian", "solver.hessian", "flag", "gauss_newton",
+          "RTI Hessian: gauss_newton (acados' default), or exact: the Hessian of the Lagrangian at the shifted "
+          "multipliers, projected per stage onto the PSD cone (no omega chatter when the goal is far)",
+          spec_choices=("gauss_newton", "exact")),
+)
+
+BY_NAME: Mapping[str, Param] = {p.name: p for p in PARAMS}
+BY_KEY: Mapping[str, Param] = {p.key: p for p in PARAMS}
+PROBLEM_PARAMS: tuple[Param, ...] = tuple(p for p in PARAMS if p.problem)
+
+
+def spec_params(spec: Any) -> dict[str, Any]:
+    """The runtime parameters' values in a resolved spec (the defaults of its generated solver)."""
+    out: dict[str, Any] = {}
+    for p in PARAMS:
+        value: Any = spec
+        for part in p.key.split("."):
+            value = getattr(value, part)
+        out[p.name] = p.spec_value(value)
+    return out
+
+
+def check_params(values: Mapping[str, Any]) -> dict[str, Any]:
+    """Every value checked against its row (unknown names refused); all problems reported at once."""
+    problems: list[str] = []
+    out: dict[str, Any] = {}
+    for key, value in values.items():
+        p = BY_NAME.get(key)
+        if p is None:
+            problems.append(f"{key}: unknown parameter; parameters are {', '.join(BY_NAME)}")
+            continue
+        v, why = p.check(value)
+        if why is not None:
+            problems.append(f"{key}: {why}: must be {p.rule}")
+        else:
+            out[key] = v
+    if problems:
+        raise ValueError("invalid runtime parameter(s):\n  - " + "\n  - ".join(problems))
+    return out

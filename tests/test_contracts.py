@@ -1,0 +1,142 @@
+"""One source per contract: the runtime parameters' table and the status table, seen the same way from
+the spec, the generated C and Python."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import humanmpc
+from humanmpc.codegen.params import PARAMS, Param
+from humanmpc.codegen.resources import runtime_dir
+from humanmpc.codegen.spec import SpecError, resolve_spec
+from humanmpc.codegen.status import StatusTableError, parse_tables, status_tables
+from humanmpc.status import QpStatus, Status, StopReason
+
+
+def out_of_range(p: Param) -> Any:
+    """A value that breaks the row's rule (and only that row's)."""
+    if p.kind == "flag":
+        return 2
+    if p.kind == "integer":
+        assert p.valid is not None
+        return int(p.valid.hi) + 1
+    if p.kind == "interval":
+        assert p.lower is not None
+        return [p.lower.hi + 1.0, p.lower.hi + 2.0]  # a lower bound above its limit
+    assert p.valid is not None
+    bad = p.valid.hi * 10.0
+    return [bad] * p.size if p.kind == "vector" else bad
+
+
+def spec_data(p: Param, value: Any) -> dict[str, Any]:
+    section, key = p.key.split(".")
+    return {section: {key: value}}
+
+
+def c_params(solver: humanmpc.Solver) -> Any:
+    """A fresh copy of the solver's C params struct (the spec's values)."""
+    ffi, lib = solver._ffi, solver._lib
+    params = ffi.new(f"{solver.name}_params *")
+    getattr(lib, f"{solver.name}_params_default")(params)
+    return params
+
+
+@pytest.mark.parametrize("p", PARAMS, ids=[p.name for p in PARAMS])
+def test_an_out_of_range_parameter_is_refused_with_the_same_rule_by_the_spec_c_and_python(
+        paper: humanmpc.Solver, p: Param) -> None:
+    bad = out_of_range(p)
+    expected = f"{p.name} must be {p.rule}"
+    # the spec
+    with pytest.raises(SpecError) as spec_err:
+        resolve_spec(spec_data(p, True if p.kind == "flag" and p.spec_choices else bad))
+    if p.kind != "flag":  # a flag is true/false in YAML (or a named choice), 0/1 in C and Python
+        assert p.rule in str(spec_err.value), str(spec_err.value)
+    # the C API
+    ffi, lib, name = paper._ffi, paper._lib, paper.name
+    params = c_params(paper)
+    assert getattr(lib, f"{name}_params_check")(params) == 0
+    setattr(params, p.name, bad)
+    which = getattr(lib, f"{name}_params_check")(params)
+    assert which == PARAMS.index(p) + 1
+    assert ffi.string(getattr(lib, f"{name}_params_rule")(which)).decode() == expected
+    # Python
+    before = paper.params
+    with pytest.raises(ValueError) as py_err:
+        paper.set_params(**{p.name: bad})
+    assert expected in str(py_err.value)
+    assert paper.params == before
+
+
+@pytest.mark.parametrize("p", [p for p in PARAMS if p.ctype == "real"], ids=lambda p: p.name)
+def test_non_finite_parameters_are_refused_by_c_and_python(paper: humanmpc.Solver, p: Param) -> None:
+    for v in (math.nan, math.inf, -math.inf):
+        params = c_params(paper)
+        setattr(params, p.name, [v] * p.size if p.size > 1 else v)
+        assert getattr(paper._lib, f"{paper.name}_params_check")(params) == PARAMS.index(p) + 1
+        with pytest.raises(ValueError, match=re.escape(p.rule)):
+            paper.set_params(**{p.name: [v] * p.size if p.size > 1 else v})
+
+
+def test_python_refuses_strings_and_booleans_where_c_holds_numbers(paper: humanmpc.Solver) -> None:
+    for key, value in (("q", "2.5"), ("q", True), ("qp_max_iter", 5.0), ("qp_max_iter", True), ("w_goal", "1234")):
+        with pytest.raises(ValueError, match="wrong type"):
+            paper.set_params(**{key: value})
+
+
+def test_a_step_with_parameters_broken_behind_pythons_back_is_a_protective_stop(paper_dir: Path) -> None:
+    """The C monitor applies the table's rules itself: a caller writing the struct directly (firmware, a
+    robot node) gets a stop with reason invalid_params, not a step with the broken value."""
+    solver = humanmpc.load(paper_dir)
+    solver._params.d_h = 150.0  # finite, but beyond the table's 100 m
+    r = solver.step([0, 0, 0, 0.5], [5, 0, 0, 0.8])
+    assert r.stop and r.stop_reason == StopReason.INVALID_PARAMS
+    solver._params.d_h = 0.5
+    assert not solver.step([0, 0, 0, 0.5], [5, 0, 0, 0.8]).stop
+
+
+def test_the_manifest_carries_the_parameter_table_with_the_specs_defaults(paper_dir: Path) -> None:
+    import json
+
+    manifest = json.loads((paper_dir / "manifest.json").read_text())
+    rows = {r["name"]: r for r in manifest["params"]}
+    assert list(rows) == [p.name for p in PARAMS]
+    assert rows["q"]["default"] == 2.0 and rows["q"]["rule"] == "a number with 0 <= q <= 1e+06"
+    assert rows["exact_hessian"]["default"] == 0 and rows["a_bounds"]["unit"] == "m/s^2"
+    assert Param.from_manifest_row(rows["kappa"]).rule == next(p for p in PARAMS if p.name == "kappa").rule
+
+
+def test_status_codes_agree_in_the_header_the_c_messages_and_the_python_enums(paper: humanmpc.Solver,
+                                                                               paper_dir: Path) -> None:
+    header = (paper_dir / f"{paper.name}.h").read_text()
+    defined = {m.group(1): int(m.group(2))
+               for m in re.finditer(rf"#define {paper.name.upper()}_([A-Z0-9_]+) (-?\d+) ", header)}
+    for enum, key, c_message in ((QpStatus, "qp_status", paper.qp_status_message), (Status, "status",
+                                 paper.status_message), (StopReason, "stop_reason", paper.stop_reason_message)):
+        rows = status_tables()[key]
+        assert [(m.name.lower(), int(m)) for m in enum] == [(r.name, r.value) for r in rows]
+        for r in rows:
+            assert defined[r.id] == r.value
+            assert c_message(r.value) == r.message == enum(r.value).message
+    assert defined["STOP_REASON_COUNT"] == len(StopReason)
+    assert humanmpc.StopReason.HUMAN_TOO_CLOSE == 6 and humanmpc.Status.SKIPPED == 3
+
+
+def test_a_malformed_status_table_is_refused_with_the_line() -> None:
+    text = (runtime_dir() / "hm_status.h").read_text()
+    assert parse_tables(text) == status_tables()
+    with pytest.raises(StatusTableError, match="repeats a value"):
+        parse_tables(text.replace("X(STOP_UNSAFE_PLAN, 7,", "X(STOP_UNSAFE_PLAN, 6,"))
+    with pytest.raises(StatusTableError, match="not a row"):
+        parse_tables(text.replace('X(QP_TIMEOUT, 5, timeout, "', 'X(QP_TIMEOUT, 5, timeout, \''))
+
+
+def test_step_results_name_their_codes_from_the_table(paper: humanmpc.Solver) -> None:
+    r = paper.step([0, 0, 0, 0.5], [5, 0, 0, 0.8], [[0.2, 0.0]], np.tile([[0.2, 0.0]], (paper.dims.N + 1, 1, 1)))
+    assert r.stop and r.reason == "human_too_close" and r.status_name == "skipped"
+    paper.reset()
