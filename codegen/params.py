@@ -64,6 +64,7 @@ class Param:
     upper: Range | None = None  # interval: the upper bound
     problem: bool = False      # part of the optimal control problem itself (the Ipopt reference's parameters)
     spec_choices: tuple[str, ...] = field(default=())  # flag set in the spec by a choice: its index is the flag
+    reason: str = ""           # why the range is what it is, said with the rule
 
     @property
     def described(self) -> str:
@@ -85,8 +86,8 @@ class Param:
             return f"{self.size} numbers, each with {self.valid.text('w')}"
         if self.kind == "interval":
             assert self.lower is not None and self.upper is not None
-            return (f"[lower, upper] with {self.lower.text('lower')}, {self.upper.text('upper')} "
-                    "and lower < upper")
+            return (f"[lower, upper] with {self.lower.text('lower')}, {self.upper.text('upper')} and lower < upper"
+                    + (f" ({self.reason})" if self.reason else ""))
         if self.kind == "integer":
             assert self.valid is not None
             return f"an integer with {self.valid.text(self.name)}"
@@ -101,29 +102,52 @@ class Param:
         return value
 
     def check(self, value: Any) -> tuple[Any, str | None]:
-        """(the value as C stores it, None) when it keeps the rule, else (None, why not)."""
-        if self.ctype == "real":
-            nums = _reals(value, self.size)
-            if nums is None:
-                return None, f"{value!r} has the wrong type or size"
-            if not all(math.isfinite(x) for x in nums):
-                return None, f"{value!r} is not finite"
-            if self.kind == "interval":
-                assert self.lower is not None and self.upper is not None
-                ok = self.lower.holds(nums[0]) and self.upper.holds(nums[1]) and nums[0] < nums[1]
-            else:
-                assert self.valid is not None
-                ok = all(self.valid.holds(x) for x in nums)
-            if not ok:
-                return None, f"{value!r} is out of range"
-            return (tuple(nums) if self.size > 1 else nums[0]), None
-        if isinstance(value, (bool, np.bool_)):
-            return (int(value), None) if self.kind == "flag" else (None, f"{value!r} has the wrong type")
-        if not isinstance(value, (int, np.integer)):
-            return None, f"{value!r} has the wrong type"
-        i = int(value)
-        ok = i in (0, 1) if self.kind == "flag" else self.valid is not None and self.valid.holds(i)
-        return (i, None) if ok else (None, f"{value!r} is out of range")
+        """(the value as C stores it, None) when it keeps the rule, else (None, what is wrong with it)."""
+        checked, why, _ = self.examine(value)
+        return checked, why
+
+    def examine(self, value: Any) -> tuple[Any, str | None, int | None]:
+        """check(), and the index of the offending entry of a vector (None when the whole value is)."""
+        if self.ctype == "int":
+            if isinstance(value, (bool, np.bool_)):
+                if self.kind == "flag":
+                    return int(value), None, None
+                return None, f"{value!r} has the wrong type", None
+            if not isinstance(value, (int, np.integer)):
+                return None, f"{value!r} has the wrong type", None
+            i = int(value)
+            ok = i in (0, 1) if self.kind == "flag" else self.valid is not None and self.valid.holds(i)
+            return (i, None, None) if ok else (None, f"{value!r} is out of range", None)
+        if self.size == 1:
+            items = [value]
+        elif isinstance(value, (list, tuple)) or (isinstance(value, np.ndarray) and value.ndim == 1):
+            items = list(value)
+        else:
+            what = "an interval [lower, upper]" if self.kind == "interval" else f"a list of {self.size} numbers"
+            return None, f"{value!r} is not {what}", None
+        if len(items) != self.size:
+            what = "an interval [lower, upper]" if self.kind == "interval" else f"a list of {self.size} numbers"
+            return None, f"{value!r} has {len(items)} entries: it is not {what} (must have exactly {self.size})", None
+        nums: list[float] = []
+        for i, v in enumerate(items):
+            entry = i if self.kind == "vector" else None
+            if isinstance(v, (bool, np.bool_, str, bytes)) or not isinstance(v, (int, float, np.integer, np.floating)):
+                return None, f"{v!r} has the wrong type: not a number", entry
+            if not math.isfinite(float(v)):
+                return None, f"{v!r} is not finite", entry
+            nums.append(float(v))
+        if self.kind == "interval":
+            assert self.lower is not None and self.upper is not None
+            if not nums[0] < nums[1]:
+                return None, f"{value!r} is reversed or empty: lower bound must be < upper bound", None
+            if not (self.lower.holds(nums[0]) and self.upper.holds(nums[1])):
+                return None, f"{value!r} is out of range", None
+            return tuple(nums), None, None
+        assert self.valid is not None
+        for i, x in enumerate(nums):
+            if not self.valid.holds(x):
+                return None, f"{items[i]!r} is out of range", (i if self.kind == "vector" else None)
+        return (tuple(nums) if self.size > 1 else nums[0]), None, None
 
     @classmethod
     def from_manifest_row(cls, row: Mapping[str, Any]) -> Param:
@@ -133,33 +157,17 @@ class Param:
         if row["kind"] not in KINDS:
             raise ValueError(f"unknown parameter kind {row['kind']!r} in the manifest")
         return cls(name=str(row["name"]), key=str(row["key"]), kind=str(row["kind"]), default=row.get("default"),
-                   doc=str(row["doc"]), unit=str(row.get("unit", "")), size=int(row["size"]), **ranges)
+                   doc=str(row["doc"]), unit=str(row.get("unit", "")), size=int(row["size"]),
+                   reason=str(row.get("reason", "")), **ranges)
 
     def manifest_row(self) -> dict[str, Any]:
         row: dict[str, Any] = {"name": self.name, "key": self.key, "kind": self.kind, "size": self.size,
-                               "unit": self.unit, "doc": self.doc, "rule": self.rule}
+                               "unit": self.unit, "doc": self.doc, "reason": self.reason, "rule": self.rule}
         for part in ("valid", "lower", "upper"):
             r = getattr(self, part)
             if r is not None:
                 row[part] = [r.lo, r.hi, r.lo_open, r.hi_open]
         return row
-
-
-def _reals(value: Any, size: int) -> list[float] | None:
-    """The entries of a real or a sequence of ``size`` reals (numbers, not strings or booleans), or None."""
-    if size == 1:
-        items = [value]
-    elif isinstance(value, (list, tuple)):
-        items = list(value)
-    elif isinstance(value, np.ndarray) and value.ndim == 1:
-        items = value.tolist()
-    else:
-        return None
-    if len(items) != size:
-        return None
-    if any(isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer, np.floating)) for v in items):
-        return None
-    return [float(v) for v in items]
 
 
 # Caps: far beyond any robot, but finite, so that no value overflows the solver's arithmetic.
@@ -193,11 +201,14 @@ PARAMS: tuple[Param, ...] = (
           valid=_WEIGHT, problem=True),
     # The bounds must admit the protective stop: standstill (v = 0), braking (a < 0) and no turning.
     Param("v_bounds", "bounds.v", "interval", (0.0, 1.0), "forward speed", unit="m/s", size=2,
-          lower=Range(-100.0, 0.0), upper=Range(0.0, 100.0, lo_open=True), problem=True),
+          lower=Range(-100.0, 0.0), upper=Range(0.0, 100.0, lo_open=True), problem=True,
+          reason="the robot must be able to come to a standstill, and to move"),
     Param("a_bounds", "bounds.a", "interval", (-1.0, 1.0), "acceleration", unit="m/s^2", size=2,
-          lower=Range(-100.0, 0.0, hi_open=True), upper=Range(0.0, 100.0, lo_open=True), problem=True),
+          lower=Range(-100.0, 0.0, hi_open=True), upper=Range(0.0, 100.0, lo_open=True), problem=True,
+          reason="a protective stop must be able to brake, and the robot to speed up"),
     Param("omega_bounds", "bounds.omega", "interval", (-1.5, 1.5), "turn rate", unit="rad/s", size=2,
-          lower=Range(-100.0, 0.0), upper=Range(0.0, 100.0), problem=True),
+          lower=Range(-100.0, 0.0), upper=Range(0.0, 100.0), problem=True,
+          reason="the robot must be able to hold its heading"),
     Param("regularization", "solver.regularization", "real", 1e-6,
           "Levenberg-Marquardt term added to the QP Hessian", valid=Range(0.0, 1e3)),
     Param("qp_tol", "solver.qp_tol", "real", 1e-6, "QP convergence tolerance", valid=Range(0.0, 1.0, lo_open=True)),

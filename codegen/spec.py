@@ -128,9 +128,10 @@ class Rule:
 
     def _check_param(self, path: str, value: Any) -> tuple[Any, list[str]]:
         assert self.param is not None
-        checked, why = self.param.check(value)
+        checked, why, entry = self.param.examine(value)
         if why is not None:
-            return None, [f"{path}: {why}: must be {self.param.rule}"]
+            where = path if entry is None else f"{path}[{entry}]"
+            return None, [f"{where}: {why}: {self.param.name} must be {self.param.rule}"]
         return checked, []
 
     # -- strings --------------------------------------------------------------------------------
