@@ -67,6 +67,7 @@ venv-test: $(STAMP_TEST)
 
 test: venv-test
 	$(PY) -m ruff check codegen python tests
+	$(PY) -m mypy codegen python
 	$(PY) -m pytest tests
 
 demo: venv

@@ -152,13 +152,15 @@ class Param:
     @classmethod
     def from_manifest_row(cls, row: Mapping[str, Any]) -> Param:
         """The row as a generated package's manifest records it (what a binding checks against)."""
-        ranges = {part: Range(float(r[0]), float(r[1]), bool(r[2]), bool(r[3]))
-                  for part in ("valid", "lower", "upper") if (r := row.get(part)) is not None}
+        def rng(part: str) -> Range | None:
+            r = row.get(part)
+            return None if r is None else Range(float(r[0]), float(r[1]), bool(r[2]), bool(r[3]))
+
         if row["kind"] not in KINDS:
             raise ValueError(f"unknown parameter kind {row['kind']!r} in the manifest")
         return cls(name=str(row["name"]), key=str(row["key"]), kind=str(row["kind"]), default=row.get("default"),
                    doc=str(row["doc"]), unit=str(row.get("unit", "")), size=int(row["size"]),
-                   reason=str(row.get("reason", "")), **ranges)
+                   reason=str(row.get("reason", "")), valid=rng("valid"), lower=rng("lower"), upper=rng("upper"))
 
     def manifest_row(self) -> dict[str, Any]:
         row: dict[str, Any] = {"name": self.name, "key": self.key, "kind": self.kind, "size": self.size,

@@ -24,7 +24,8 @@ _MESSAGES: dict[str, dict[int, str]] = {}
 def _enum(class_name: str, key: str) -> type[_Coded]:
     rows = status_tables()[key]
     _MESSAGES[class_name] = {r.value: r.message for r in rows}
-    return _Coded(class_name, [(r.name.upper(), r.value) for r in rows])  # type: ignore[return-value]
+    members = [(r.name.upper(), r.value) for r in rows]
+    return _Coded(class_name, members)  # type: ignore[call-arg, arg-type, return-value]
 
 
 QpStatus = _enum("QpStatus", "qp_status")
