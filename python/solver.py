@@ -214,15 +214,17 @@ class Solver:
 
         Every value is checked against its row of the parameter table (type, size, range: the rules of
         the spec and of the C check, named in the same words) before any is written; a ValueError
-        lists every value that breaks its rule, and nothing is changed.
+        lists every value that breaks its rule (a KeyError names unknown parameters), and nothing is
+        changed.
         """
+        unknown = [key for key in values if key not in self._param_rows]
+        if unknown:
+            raise KeyError(f"unknown parameter {', '.join(repr(k) for k in unknown)}; parameters are "
+                           f"{', '.join(self._param_rows)}")
         problems: list[str] = []
         staged: list[tuple[str, Any]] = []
         for key, value in values.items():
-            row = self._param_rows.get(key)
-            if row is None:
-                problems.append(f"{key}: unknown parameter; parameters are {', '.join(self._param_rows)}")
-                continue
+            row = self._param_rows[key]
             checked, why = row.check(value)
             if why is not None:
                 problems.append(f"{key}: {why}: {row.name} must be {row.rule}")

@@ -14,7 +14,7 @@ import pytest
 
 from humanmpc.codegen.ocp import DIST_EPS, OcpModel, smooth_distance
 from humanmpc.codegen.spec import resolve_spec
-from humanmpc.compare.peers.acados import PEER_SCRIPT, AcadosRun, ensure_acados_venv, find_python312, run_acados
+from humanmpc.compare.peers.acados_client import PEER_SCRIPT, AcadosRun, ensure_acados_venv, find_python312, run_acados
 from humanmpc.compare.replay import Replay, synthetic_replay
 
 from .conftest import REPO_ROOT

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from humanmpc.codegen.spec import resolve_spec
-from humanmpc.compare.peers.acados import find_python312
+from humanmpc.compare.peers.acados_client import find_python312
 from humanmpc.compare.peers.ipopt import ipopt_unavailable_reason
 from humanmpc.compare.replay import synthetic_replay
 from humanmpc.compare.report import (

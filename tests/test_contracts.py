@@ -85,7 +85,7 @@ def test_non_finite_parameters_are_refused_by_c_and_python(paper: humanmpc.Solve
 
 def test_python_refuses_strings_and_booleans_where_c_holds_numbers(paper: humanmpc.Solver) -> None:
     for key, value in (("q", "2.5"), ("q", True), ("qp_max_iter", 5.0), ("qp_max_iter", True), ("w_goal", "1234")):
-        with pytest.raises(ValueError, match="wrong type|is not a list of 4 numbers"):
+        with pytest.raises(ValueError, match=r"wrong type|is not a list of 4 numbers"):
             paper.set_params(**{key: value})
 
 

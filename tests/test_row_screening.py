@@ -67,5 +67,5 @@ def test_row_screening_is_a_runtime_parameter_checked_like_the_others(crowd_dir:
     assert solver.params["row_screening"] == 1
     solver.set_params(row_screening=False)
     assert solver.params["row_screening"] == 0
-    with pytest.raises(ValueError, match="row_screening must be true or false"):
+    with pytest.raises(ValueError, match="row_screening must be 0 or 1"):
         solver.set_params(row_screening=2)

@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 
 from ..codegen.reference_nlp import ReferenceNlp
 from ..codegen.spec import Spec, load_spec, resolve_spec
-from .peers.acados import (
+from .peers.acados_client import (
     ACADOS_PACKAGE,
     DEFAULT_ACADOS_VENV,
     AcadosUnavailableError,

@@ -80,7 +80,8 @@ def add_firmware_parser(subparsers: Any) -> None:
     p.add_argument("dir", type=Path, help="generated solver folder")
     p.add_argument("--cpu", choices=sorted(CPUS), default="cortex-m7",
                    help="cortex-m4 (mps2-an386, single-precision FPU) or cortex-m7 (mps2-an500); default cortex-m7")
-    p.add_argument("--replay", type=Path, help="a replay .npz (humanmpc.compare.replay format) instead of a recorded loop")
+    p.add_argument("--replay", type=Path, help="a replay .npz (humanmpc.compare.replay format) instead of a "
+                   "recorded loop")
     p.add_argument("--steps", type=int, default=60, help="steps of the recorded loop (default 60)")
     p.add_argument("--seed", type=int, default=0, help="seed of the recorded crowd (default 0)")
     p.add_argument("--humans", type=int, help="humans in the recorded crowd (default: the solver's N_h)")
