@@ -20,7 +20,23 @@ from .spec import IDENT_RE, Spec
 _C_FLOAT = re.compile(r"^-?[0-9]+(\.[0-9]*)?(e[-+]?[0-9]+)?$")
 
 # Runtime files compiled into the solver's translation unit, in dependency order.
-RUNTIME_SOURCES = ("ocp_qp.c", "ocp_qp_kkt.c", "ocp_qp_ipm.c", "monitor.c", "ocp_nlp_sqp.c")
+RUNTIME_SOURCES = (
+    "ocp_qp.c",
+    "ocp_qp_kkt.c",
+    "ocp_qp_hsde.c",
+    "ocp_qp_ipm_setup.c",
+    "ocp_qp_ipm_lanes.c",
+    "ocp_qp_ipm_pass_a.c",
+    "ocp_qp_ipm_measures.c",
+    "ocp_qp_ipm_pred_corr.c",
+    "ocp_qp_ipm_sol.c",
+    "ocp_qp_ipm_cert.c",
+    "ocp_qp_ipm_polish.c",
+    "ocp_qp_ipm_warm.c",
+    "ocp_qp_ipm.c",
+    "monitor.c",
+    "ocp_nlp_sqp.c",
+)
 
 # Template -> file name in the generated folder ({name} is the spec's name).
 TEMPLATES = {
