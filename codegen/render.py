@@ -34,7 +34,13 @@ RUNTIME_SOURCES = (
     "ocp_qp_ipm_polish.c",
     "ocp_qp_ipm_warm.c",
     "ocp_qp_ipm.c",
+    "ocp_nlp_common.c",
     "monitor.c",
+    "ocp_nlp_lin.c",
+    "ocp_nlp_screen.c",
+    "ocp_nlp_step.c",
+    "ocp_nlp_out.c",
+    "ocp_nlp_rti.c",
     "ocp_nlp_sqp.c",
 )
 
