@@ -1,7 +1,7 @@
 /*
- * monitor.c: input and parameter checks and the distance checks of the safety monitor
- * (see monitor.h). The protective stop itself and the C1/C2 decisions are in ocp_nlp_sqp.c, where
- * the solver's state is.
+ * monitor.c: the safety monitor's tests (see monitor.h): input and parameter checks and the distance
+ * of the robot to the humans now, stateless, called before and after every solver step. The
+ * protective stop itself and the C1/C2 decisions are in ocp_nlp_out.c, where the solver's state is.
  */
 #include "monitor.h"
 

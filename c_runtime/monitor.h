@@ -19,7 +19,7 @@
 #define HM_MONITOR_H
 
 #include "hm_common.h"
-#include "ocp_nlp_sqp.h" /* hm_input, hm_params */
+#include "ocp_nlp_common.h" /* hm_input, hm_params */
 
 /* Why a protective stop is in force. Fixed values: part of the public C and Python API. */
 enum hm_stop_reason {

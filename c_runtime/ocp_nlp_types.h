@@ -19,7 +19,7 @@ typedef struct HM_NS(solver) {
     int n_active;    /* humans and obstacle rows of the current linearisation */
     int dyn_fresh;   /* 1: qp.A, qp.B are the dynamics' Jacobians at the iterate, which was just
                         simulated (no gaps): the next linearisation need not evaluate them again */
-    /* Row screening (ocp_nlp_sqp.c): rows of stage n whose linearised margin is not below
+    /* Row screening (ocp_nlp_screen.c): rows of stage n whose linearised margin is not below
      * screen_radius[n] are left out of the QP (screened, their lg kept in screened_lg and made
      * absent in qp.lg) and checked after. */
     HM_REAL screen_radius[HM_N + 1];

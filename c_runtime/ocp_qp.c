@@ -1,5 +1,6 @@
 /*
- * ocp_qp.c: helpers on the data of the stage-structured QP (see ocp_qp.h).
+ * ocp_qp.c: helpers on the data of the stage-structured QP (see ocp_qp.h): set to zero, checked
+ * before a solve, and the KKT residuals of a primal-dual pair, measured after it. Stateless.
  */
 #include "ocp_qp.h"
 

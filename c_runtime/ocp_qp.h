@@ -1,5 +1,5 @@
 /*
- * ocp_qp.h: helpers on the data of the stage-structured QP (hm_types.h: ocp_qp, ocp_qp_sol).
+ * ocp_qp.h: helpers on the data of the stage-structured QP (ocp_qp_types.h: ocp_qp, ocp_qp_sol).
  *
  * Sign conventions of ocp_qp_sol. All multipliers of inequalities are >= 0 and the Lagrangian is
  *
@@ -33,7 +33,8 @@ HM_FUNC int ocp_qp_check(const hm_ocp_qp *qp);
 /* 1 if the bound or row right-hand side takes part in the problem. */
 HM_FUNC int ocp_qp_bound_present(hm_real bound);
 
-/* Residuals of the KKT conditions of (qp, sol) in the conventions above (hm_types.h: ocp_qp_res). */
+/* Residuals of the KKT conditions of (qp, sol) in the conventions above (ocp_qp_types.h:
+ * ocp_qp_res). */
 HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, hm_ocp_qp_res *res);
 
 /* The same at the zero step (u = 0, x_n = 0 for n >= 1, x_0 = qp->x0: the linearisation point of an

@@ -1,9 +1,12 @@
 /*
  * ocp_qp_hsde.c: the fallback solver of ocp_qp_ipm_solve (ocp_qp_hsde.h): the homogeneous self-dual
- * embedding interior-point method, with its own packed row layout and Riccati factorisation.
- * #included by ocp_qp_ipm.c (the runtime's list of translation-unit sources is fixed).
+ * embedding interior-point method, with its own packed row layout and Riccati factorisation. Runs
+ * when the primal-dual iteration stalls, from scratch, in the memory that the primal-dual method's
+ * stage blocks otherwise occupy (ocp_qp_ipm_ws.u).
  */
+#include "ocp_qp.h"
 #include "ocp_qp_hsde.h"
+#include "ocp_qp_kkt.h"
 
 
 /* Inverse square root of a pivot of the 2x2 input block, or -1 if the pivot is not positive beyond

@@ -2,21 +2,21 @@
  * ocp_qp_ipm.h: primal-dual interior-point solver (Mehrotra predictor-corrector) for ocp_qp, with
  * Riccati-factorised Newton systems (ocp_qp_kkt.h).
  *
- * Algorithm. The QP (hm_types.h) with primal v = (u, x, s), dynamics A_E v = b_E and inequalities
- * A_I v + t = b_I, t >= 0 (multipliers z >= 0) is solved by an infeasible-start primal-dual
+ * Algorithm. The QP (ocp_qp_types.h) with primal v = (u, x, s), dynamics A_E v = b_E and
+ * inequalities A_I v + t = b_I, t >= 0 (multipliers z >= 0) is solved by an infeasible-start primal-dual
  * interior-point method: the iterate (v, y, z, t) with t, z > 0 follows the central path of
  *     P v + q + A_E' y + A_I' z = 0,   A_E v = b_E,   A_I v + t = b_I,   t o z = mu.
  * A soft row's slack s is the slack of its own bound s >= 0 (no second slack variable). The cost is
  * scaled by 1 / max(largest Hessian diagonal, largest gradient entry) (clipped to [1e-4, 1e4]). The
  * start is v = 0 (soft slacks just satisfying their rows, plus 1), y = 0, t = max(b_I - A_I v, 1),
  * z = 1 / t, or (arg->warm_start) the slacks and multipliers of an early iterate that the previous
- * solve kept (arg->warm_mu), floored (ocp_qp_ipm.c: consecutive QPs of the real-time iteration).
- * One iteration factorises the Newton matrix once (ocp_qp_kkt.h) and solves it twice:
+ * solve kept (arg->warm_mu), floored (ocp_qp_ipm_warm.c: consecutive QPs of the real-time
+ * iteration). One iteration factorises the Newton matrix once (ocp_qp_kkt.h) and solves it twice:
  * the affine predictor, and the Mehrotra corrector with centring sigma = (mu_aff / mu)^3. Both
  * target the full primal and dual residuals; the step is a fraction of the largest step that keeps
  * t, z >= 0: arg->step_frac early, rising to 1 - mu/mu_0 late (never above 1 - sqrt(eps)). The
- * weights z / t of the Newton matrix are capped (ocp_qp_ipm.c) so that the Riccati recursion keeps
- * its accuracy near the solution.
+ * weights z / t of the Newton matrix are capped (ocp_qp_ipm_setup.c) so that the Riccati recursion
+ * keeps its accuracy near the solution.
  *
  * The residuals of the linear equations (dynamics, stationarity of (u, x)) follow the steps by
  * their recurrence r <- (1 - alpha) r (a Newton step solves those equations), and are evaluated
@@ -27,7 +27,7 @@
  *   SOLVED      primal and dual residuals (inf-norms), each divided by max(1, norms of the terms it
  *               is made of), and the complementarity t' z (the duality gap, in the units of the
  *               data) in absolute terms or relative to max(1, |cost|), all below arg->tol. Then, with
- *               arg->polish, the active-set polish (ocp_qp_ipm.c): the QP solved once more as an
+ *               arg->polish, the active-set polish (ocp_qp_ipm_polish.c): the QP solved once more as an
  *               equality-constrained QP on the rows the iterate has active, kept only if its worst
  *               KKT residual (ocp_qp_res_compute) is smaller (ws->out.polished).
  *   INFEASIBLE  the dual iterate is a Farkas certificate: b' w < 0 and ||A' w||_inf <=
@@ -44,7 +44,7 @@
  *               arg->min_step, mu fell below eps^2 mu_0 (the residuals are stuck at their rounding
  *               floor above tol), or (with arg->detect_unbounded) a direction of unbounded
  *               descent was found: q' v < 0 with
- *               P v, A_E v - b_E... see ocp_qp_ipm.c (ws->out.unbounded = 1; no minimiser).
+ *               P v, A_E v - b_E... see ocp_qp_ipm_cert.c (ws->out.unbounded = 1; no minimiser).
  *   NONFINITE   NaN or Inf in the data (checked before any work) or in the iterates.
  *   MAX_ITER / TIMEOUT  arg->max_iter iterations done / arg->should_stop returned nonzero (polled
  *               once per iteration, before its work).

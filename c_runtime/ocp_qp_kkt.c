@@ -1,6 +1,7 @@
 /*
  * ocp_qp_kkt.c: Riccati factorisation and solution of the interior-point Newton system
- * (see ocp_qp_kkt.h).
+ * (see ocp_qp_kkt.h): factorised once per iteration, solved twice (predictor, corrector), in the
+ * stage blocks of the solve.
  *
  * Stage n carries the variables (u_n, x_n) in this order, a 6-vector whose Hessian is
  * H_n = [R S; S' Q] (S is stored as the 2x4 block u-by-x) plus the condensed inequalities; stage 0
@@ -14,26 +15,6 @@
  * compile-time bounds and products are in axpy form over contiguous columns (2-wide SIMD).
  */
 #include "ocp_qp_kkt.h"
-
-/* F = P M for the symmetric 4x4 P (stored in full) and the 4 x ncol matrix M, in axpy form. */
-HM_KERNEL void ocp_qp_kkt_mul4(const hm_real *restrict P, const hm_real *restrict M, hm_real *restrict F, int ncol)
-{
-    int i, j, k;
-    for (j = 0; j < ncol; j++) {
-        hm_real f[HM_NX];
-        for (i = 0; i < HM_NX; i++) f[i] = P[i] * M[j * HM_NX];
-        for (k = 1; k < HM_NX; k++) {
-            const hm_real mk = M[k + j * HM_NX];
-            for (i = 0; i < HM_NX; i++) f[i] += P[i + k * HM_NX] * mk;
-        }
-        for (i = 0; i < HM_NX; i++) F[i + j * HM_NX] = f[i];
-    }
-}
-
-HM_KERNEL hm_real ocp_qp_kkt_dot4(const hm_real *restrict a, const hm_real *restrict b)
-{
-    return (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
-}
 
 /* y = P x for the full 4x4 P */
 HM_KERNEL void ocp_qp_kkt_mv4(const hm_real *restrict P, const hm_real *restrict x, hm_real *restrict y)

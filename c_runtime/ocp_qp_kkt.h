@@ -3,9 +3,9 @@
  *
  * With v = (u_0, x_1, s_1, u_1, ..., x_N, s_N) the primal variables, P the QP Hessian (times the
  * cost scale), A_E v = b_E the dynamics (rows x_{n+1} - A_n x_n - B_n u_n), A_I v + t = b_I the
- * inequalities (t >= 0; the families of hm_types.h: bound sides, soft rows -(D' p + s) + t = -lg,
- * their s >= 0 as -s + t = 0, hard rows -D' p + t = -lg) and w > 0 one weight per inequality (z / t
- * in the interior-point method), the system is
+ * inequalities (t >= 0; the families of ocp_qp_ipm_types.h: bound sides, soft rows
+ * -(D' p + s) + t = -lg, their s >= 0 as -s + t = 0, hard rows -D' p + t = -lg) and w > 0 one weight
+ * per inequality (z / t in the interior-point method), the system is
  *
  *     [ P    A_E'  A_I'         ] [dv ]   [rhs.ux, rhs.s]
  *     [ A_E  0     0            ] [dy ] = [rhs.y        ]
@@ -18,10 +18,11 @@
  * depends on the weights only; one factorisation serves any number of right-hand sides.
  *
  * The stage kernels (ocp_qp_kkt_factor_stage, _backward_stage, _forward_stage) are what the
- * interior-point iteration runs, fused with its own passes (ocp_qp_ipm.c). ocp_qp_kkt_condense_weights,
- * ocp_qp_kkt_factorize and ocp_qp_kkt_solve are the same system for a general right-hand side in the
- * layout of ocp_qp_ipm_vec, with the weights taken from the stage blocks (bw, swr, sws, hw): the
- * tests compare them with a dense solve, and the active-set polish uses them.
+ * interior-point iteration runs, fused with its own passes (ocp_qp_ipm_pred_corr.c).
+ * ocp_qp_kkt_condense_weights, ocp_qp_kkt_factorize and ocp_qp_kkt_solve are the same system for a
+ * general right-hand side in the layout of ocp_qp_ipm_vec, with the weights taken from the stage
+ * blocks (bw, swr, sws, hw): the tests compare them with a dense solve, and the active-set polish
+ * uses them.
  */
 #ifndef OCP_QP_KKT_H
 #define OCP_QP_KKT_H
@@ -70,5 +71,27 @@ HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws);
  * blocks' ry, p, yk as scratch. */
 HM_FUNC void ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_vec *rhs,
                               hm_ocp_qp_ipm_vec *sol);
+
+/* 4x4 kernels of the recursion that the fallback solver and the interior-point method use too, inline
+ * as in the recursion. F = P M for the symmetric 4x4 P (stored in full) and the 4 x ncol matrix M,
+ * in axpy form. */
+HM_KERNEL void ocp_qp_kkt_mul4(const hm_real *restrict P, const hm_real *restrict M, hm_real *restrict F, int ncol)
+{
+    int i, j, k;
+    for (j = 0; j < ncol; j++) {
+        hm_real f[HM_NX];
+        for (i = 0; i < HM_NX; i++) f[i] = P[i] * M[j * HM_NX];
+        for (k = 1; k < HM_NX; k++) {
+            const hm_real mk = M[k + j * HM_NX];
+            for (i = 0; i < HM_NX; i++) f[i] += P[i + k * HM_NX] * mk;
+        }
+        for (i = 0; i < HM_NX; i++) F[i + j * HM_NX] = f[i];
+    }
+}
+
+HM_KERNEL hm_real ocp_qp_kkt_dot4(const hm_real *restrict a, const hm_real *restrict b)
+{
+    return (a[0] * b[0] + a[1] * b[1]) + (a[2] * b[2] + a[3] * b[3]);
+}
 
 #endif /* OCP_QP_KKT_H */

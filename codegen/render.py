@@ -22,7 +22,29 @@ from .status import status_tables
 _C_FLOAT = re.compile(r"^-?[0-9]+(\.[0-9]*)?(e[-+]?[0-9]+)?$")
 
 # Runtime files compiled into the solver's translation unit, in dependency order.
-RUNTIME_SOURCES = ("ocp_qp.c", "ocp_qp_kkt.c", "ocp_qp_ipm.c", "monitor.c", "ocp_nlp_sqp.c")
+RUNTIME_SOURCES = (
+    "ocp_qp.c",
+    "ocp_qp_kkt.c",
+    "ocp_qp_hsde.c",
+    "ocp_qp_ipm_setup.c",
+    "ocp_qp_ipm_lanes.c",
+    "ocp_qp_ipm_pass_a.c",
+    "ocp_qp_ipm_measures.c",
+    "ocp_qp_ipm_pred_corr.c",
+    "ocp_qp_ipm_sol.c",
+    "ocp_qp_ipm_cert.c",
+    "ocp_qp_ipm_polish.c",
+    "ocp_qp_ipm_warm.c",
+    "ocp_qp_ipm.c",
+    "ocp_nlp_common.c",
+    "monitor.c",
+    "ocp_nlp_lin.c",
+    "ocp_nlp_screen.c",
+    "ocp_nlp_step.c",
+    "ocp_nlp_out.c",
+    "ocp_nlp_rti.c",
+    "ocp_nlp_sqp.c",
+)
 
 # Template -> file name in the generated folder ({name} is the spec's name).
 TEMPLATES = {

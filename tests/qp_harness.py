@@ -37,7 +37,7 @@ Array = np.ndarray[Any, np.dtype[np.float64]]
 
 @dataclass
 class QP:
-    """The QP of c_runtime/hm_types.h (ocp_qp), natural matrix shapes (A[n] is 4x4, S[n] is 2x4)."""
+    """The QP of c_runtime/ocp_qp_types.h (ocp_qp), natural matrix shapes (A[n] is 4x4, S[n] is 2x4)."""
 
     A: Array
     B: Array
@@ -440,7 +440,7 @@ def clarabel_solve(qp: QP, tol: float = 1e-12) -> RefSolution:
 
 
 # ------------------------------------------------------------------------------------------------
-# Independent KKT check from the problem statement of hm_types.h and the conventions of ocp_qp.h
+# Independent KKT check from the problem statement of ocp_qp_types.h and the conventions of ocp_qp.h
 # ------------------------------------------------------------------------------------------------
 
 

@@ -20,9 +20,7 @@
 typedef HM_REAL hm_real;
 #include "hm_aliases.h"
 
-#include "ocp_qp.c"
-#include "ocp_qp_kkt.c"
-#include "ocp_qp_ipm.c"
+#include "qp_runtime.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,0 +1,284 @@
+/*
+ * ocp_nlp_lin.c: the linearisation of the NLP, once per SQP iteration (in the real-time iteration's
+ * preparation phase): its point (the previous plan shifted and re-simulated, the cold guess, or the
+ * braking guess), the QP of the model's derivatives there (Gauss-Newton, or the exact Hessian made
+ * convex) with the objective, and, at feedback, the measured state as the QP's x_0 offset.
+ * Model functions: the hm_model_* macros of the translation unit (ocp_nlp_common.h).
+ */
+#include "ocp_nlp_lin.h"
+
+#include "ocp_nlp_screen.h"
+#include "ocp_qp.h"
+
+/* x_{n+1} = F(x_n, u_n) for n = 0..N-1 from the given x_0. The Jacobians come with the model's
+ * values; they are kept in the QP for the linearisation that follows (s->dyn_fresh). */
+static void ocp_nlp_simulate(hm_solver *s)
+{
+    int n;
+    for (n = 0; n < HM_N; n++) hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], s->qp.A[n], s->qp.B[n]);
+    s->dyn_fresh = 1;
+}
+
+/* a[r][.] <- a[r + 1][.] for r < rows - 1; the last row is kept. */
+static void ocp_nlp_shift_rows(hm_real *a, int rows, int cols)
+{
+    int k;
+    for (k = 0; k < (rows - 1) * cols; k++) a[k] = a[k + cols];
+}
+
+/* Initial guess of the next step: the previous plan shifted by one interval (the last control
+ * repeated), re-simulated from the predicted state; or, cold, the controls held at zero from x0. */
+HM_FUNC void ocp_nlp_shift(hm_solver *s, const hm_input *in)
+{
+    int n, i;
+    if (!s->warm) {
+        for (i = 0; i < HM_NX; i++) s->x[0][i] = in->x0[i];
+        for (n = 0; n < HM_N; n++)
+            for (i = 0; i < HM_NU; i++) s->u[n][i] = HM_R(0.0);
+        ocp_nlp_screen_reach(s); /* no previous step to size the screening by */
+    } else {
+        hm_ocp_qp_sol *m = &s->mult;
+        for (i = 0; i < HM_NX; i++) s->x[0][i] = s->x[1][i];
+        for (n = 0; n + 1 < HM_N; n++)
+            for (i = 0; i < HM_NU; i++) s->u[n][i] = s->u[n + 1][i];
+        /* The multipliers follow their stages (they only enter the reported residuals). */
+        ocp_nlp_shift_rows(&m->pi[0][0], HM_N, HM_NX);
+        ocp_nlp_shift_rows(&m->lam_lbu[0][0], HM_N, HM_NU);
+        ocp_nlp_shift_rows(&m->lam_ubu[0][0], HM_N, HM_NU);
+        ocp_nlp_shift_rows(&m->lam_lbx[0][0], HM_N + 1, HM_NX);
+        ocp_nlp_shift_rows(&m->lam_ubx[0][0], HM_N + 1, HM_NX);
+        ocp_nlp_shift_rows(&m->lam_lg[0][0], HM_N + 1, HM_NG);
+        ocp_nlp_shift_rows(&m->lam_ls[0][0], HM_N + 1, HM_NG);
+    }
+    ocp_nlp_simulate(s);
+}
+
+/* The safe fallback guess: brake to standstill within the acceleration bound, without turning,
+ * from the measured state. Whenever braking keeps d_h, this guess satisfies every human row, so
+ * the QP linearised at it (zero step feasible, rows convex) returns a plan that keeps d_h too. */
+HM_FUNC void ocp_nlp_init_braking(hm_solver *s, const hm_input *in)
+{
+    const hm_real a_min = s->params.a_bounds[0], a_max = s->params.a_bounds[1];
+    int n, i;
+    for (i = 0; i < HM_NX; i++) s->x[0][i] = in->x0[i];
+    for (n = 0; n < HM_N; n++) {
+        s->u[n][0] = hm_fmin(hm_fmax(-s->x[n][3] / HM_R(HM_DT), a_min), a_max);
+        s->u[n][1] = HM_R(0.0);
+        hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], s->qp.A[n], s->qp.B[n]);
+    }
+    s->dyn_fresh = 1;
+    ocp_qp_sol_set_zero(&s->mult);
+    ocp_nlp_screen_reach(s);
+}
+
+HM_FUNC hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2)
+{
+    /* The slack a row needs at this point: s = max(0, -g). */
+    const hm_real sl = g < HM_R(0.0) ? -g : HM_R(0.0);
+    return l1 * sl + HM_R(0.5) * l2 * sl * sl;
+}
+
+/* Symmetric n x n M (column-major, n <= 6) replaced by its projection onto {eigenvalues >= floor}:
+ * cyclic Jacobi rotations, then V max(Lambda, floor) V'. */
+static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
+{
+    hm_real V[36], off, total = HM_R(0.0);
+    int i, j, k, sweep;
+    for (i = 0; i < n * n; i++) {
+        V[i] = HM_R(0.0);
+        total += M[i] * M[i];
+    }
+    for (i = 0; i < n; i++) V[i + i * n] = HM_R(1.0);
+    for (sweep = 0; sweep < 30; sweep++) {
+        off = HM_R(0.0);
+        for (i = 0; i < n; i++)
+            for (j = i + 1; j < n; j++) off += M[i + j * n] * M[i + j * n];
+        if (off <= HM_EPS * HM_EPS * total) break;
+        for (i = 0; i < n; i++) {
+            for (j = i + 1; j < n; j++) {
+                const hm_real mij = M[i + j * n];
+                hm_real theta, t, c, sn;
+                if (mij == HM_R(0.0)) continue;
+                theta = (M[j + j * n] - M[i + i * n]) / (HM_R(2.0) * mij);
+                t = (theta >= HM_R(0.0) ? HM_R(1.0) : HM_R(-1.0)) / (hm_fabs(theta) + hm_sqrt(theta * theta + HM_R(1.0)));
+                c = HM_R(1.0) / hm_sqrt(t * t + HM_R(1.0));
+                sn = t * c;
+                for (k = 0; k < n; k++) { /* M <- M J */
+                    const hm_real a = M[k + i * n], b = M[k + j * n];
+                    M[k + i * n] = c * a - sn * b;
+                    M[k + j * n] = sn * a + c * b;
+                }
+                for (k = 0; k < n; k++) { /* M <- J' M */
+                    const hm_real a = M[i + k * n], b = M[j + k * n];
+                    M[i + k * n] = c * a - sn * b;
+                    M[j + k * n] = sn * a + c * b;
+                }
+                for (k = 0; k < n; k++) { /* V <- V J */
+                    const hm_real a = V[k + i * n], b = V[k + j * n];
+                    V[k + i * n] = c * a - sn * b;
+                    V[k + j * n] = sn * a + c * b;
+                }
+            }
+        }
+    }
+    {
+        hm_real lam[6];
+        for (k = 0; k < n; k++) lam[k] = hm_fmax(M[k + k * n], floor);
+        for (i = 0; i < n; i++) {
+            for (j = 0; j < n; j++) {
+                hm_real acc = HM_R(0.0);
+                for (k = 0; k < n; k++) acc += V[i + k * n] * lam[k] * V[j + k * n];
+                M[i + j * n] = acc;
+            }
+        }
+    }
+}
+
+/* Stage n's Hessian blocks [Q S'; S R] (or Q alone at n = N) projected onto the PSD cone. */
+static void ocp_nlp_convexify_stage(hm_ocp_qp *qp, int n, hm_real floor)
+{
+    hm_real M[36];
+    const int nz = n < HM_N ? HM_NX + HM_NU : HM_NX;
+    int i, j;
+    for (j = 0; j < HM_NX; j++)
+        for (i = 0; i < HM_NX; i++) M[i + j * nz] = qp->Q[n][i + j * HM_NX];
+    if (n < HM_N) {
+        for (j = 0; j < HM_NX; j++)
+            for (i = 0; i < HM_NU; i++) {
+                M[HM_NX + i + j * nz] = qp->S[n][i + j * HM_NU];
+                M[j + (HM_NX + i) * nz] = qp->S[n][i + j * HM_NU];
+            }
+        for (j = 0; j < HM_NU; j++)
+            for (i = 0; i < HM_NU; i++) M[HM_NX + i + (HM_NX + j) * nz] = qp->R[n][i + j * HM_NU];
+    }
+    ocp_nlp_project_psd(M, nz, floor);
+    for (j = 0; j < HM_NX; j++)
+        for (i = 0; i < HM_NX; i++) qp->Q[n][i + j * HM_NX] = M[i + j * nz];
+    if (n < HM_N) {
+        for (j = 0; j < HM_NX; j++)
+            for (i = 0; i < HM_NU; i++) qp->S[n][i + j * HM_NU] = M[HM_NX + i + j * nz];
+        for (j = 0; j < HM_NU; j++)
+            for (i = 0; i < HM_NU; i++) qp->R[n][i + j * HM_NU] = M[HM_NX + i + (HM_NX + j) * nz];
+    }
+}
+
+/* Build the QP of the current iterate (everything but the initial-state offset) and the NLP
+ * objective there. Rows: the present humans first, then the obstacle; absent ones cost nothing.
+ * exact = 0: Gauss-Newton Hessian (PSD by construction). exact = 1: the Hessian of the Lagrangian
+ * with the multipliers in s->mult, projected per stage onto the PSD cone (full SQP). */
+HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
+{
+    const hm_params *p = &s->params;
+    hm_ocp_qp *qp = &s->qp;
+    const int nh = ocp_nlp_clamp_humans(in);
+    const int ng = nh + (in->has_obstacle ? 1 : 0);
+    const hm_real reg = p->regularization;
+    hm_real cost = HM_R(0.0), penalty = HM_R(0.0);
+    int n, i, j;
+
+    for (n = 0; n <= HM_N; n++) {
+        hm_real *x = s->x[n];
+        hm_real *Q = qp->Q[n];
+        hm_real *q = qp->q[n];
+        hm_real l;
+
+        if (n < HM_N) {
+            if (s->dyn_fresh) {
+                /* simulated from this very iterate: the same evaluation would give x_next =
+                 * x[n + 1] exactly, and the Jacobians are in qp already */
+                for (i = 0; i < HM_NX; i++) qp->b[n][i] = HM_R(0.0);
+            } else {
+                hm_real x_next[HM_NX];
+                hm_model_dynamics(x, s->u[n], x_next, qp->A[n], qp->B[n]);
+                for (i = 0; i < HM_NX; i++) qp->b[n][i] = x_next[i] - s->x[n + 1][i];
+            }
+            hm_model_cost_stage(x, s->u[n], in->goal, p->w_goal, p->w_control, &l, q, qp->r[n], Q, qp->R[n]);
+            for (i = 0; i < HM_NU; i++) qp->R[n][i + i * HM_NU] += reg;
+            for (i = 0; i < HM_NU * HM_NX; i++) qp->S[n][i] = HM_R(0.0);
+            if (exact) {
+                hm_real hxx[HM_NX * HM_NX], hux[HM_NU * HM_NX], huu[HM_NU * HM_NU];
+                hm_model_dynamics_hessian(x, s->u[n], s->mult.pi[n], hxx, hux, huu);
+                for (i = 0; i < HM_NX * HM_NX; i++) Q[i] += hxx[i];
+                for (i = 0; i < HM_NU * HM_NX; i++) qp->S[n][i] = hux[i];
+                for (i = 0; i < HM_NU * HM_NU; i++) qp->R[n][i] += huu[i];
+            }
+            qp->lbu[n][0] = p->a_bounds[0] - s->u[n][0];
+            qp->ubu[n][0] = p->a_bounds[1] - s->u[n][0];
+            qp->lbu[n][1] = p->omega_bounds[0] - s->u[n][1];
+            qp->ubu[n][1] = p->omega_bounds[1] - s->u[n][1];
+        } else {
+            hm_model_cost_terminal(x, in->goal, p->w_goal_terminal, &l, q, Q);
+        }
+        for (i = 0; i < HM_NX; i++) Q[i + i * HM_NX] += reg;
+        cost += l;
+
+        /* Collision cost of each present human at its predicted position at this node: exact
+         * gradient, Gauss-Newton Hessian on the (px, py) block. */
+        for (j = 0; j < nh; j++) {
+            hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP], hess_exact[HM_NP * HM_NP];
+            const hm_real *hess = hess_gn;
+            if (exact) {
+                hm_model_cost_collision(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn,
+                                        hess_exact);
+                hess = hess_exact;
+            } else {
+                hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
+            }
+            cost += f;
+            q[0] += grad[0];
+            q[1] += grad[1];
+            Q[0] += hess[0];
+            Q[1] += hess[1];
+            Q[HM_NX] += hess[2];
+            Q[HM_NX + 1] += hess[3];
+        }
+
+        /* Node 0 is the measured state: its bounds and rows cannot be acted on. */
+        for (i = 0; i < HM_NX; i++) {
+            qp->lbx[n][i] = -HM_INF;
+            qp->ubx[n][i] = HM_INF;
+        }
+        if (n == 0) {
+            qp->ng[0] = 0;
+            continue;
+        }
+        qp->lbx[n][3] = p->v_bounds[0] - x[3];
+        qp->ubx[n][3] = p->v_bounds[1] - x[3];
+        qp->ng[n] = ng;
+        for (j = 0; j < ng; j++) {
+            const int human = j < nh;
+            const hm_real *c = human ? in->humans_now[j] : in->obstacle;
+            const hm_real *d_min = human ? &p->d_h : &p->d_s;
+            const hm_real l1 = human ? p->human_slack_l1 : p->slack_l1;
+            const hm_real l2 = human ? p->human_slack_l2 : p->slack_l2;
+            hm_real g, hess_d[HM_NP * HM_NP];
+            hm_model_distance_constraint(x, c, d_min, &g, qp->D[n][j], hess_d);
+            if (exact) {
+                /* L = cost - lam (d - d_min + s): the row's curvature enters with -lam. */
+                const hm_real lam = s->mult.lam_lg[n][j];
+                Q[0] -= lam * hess_d[0];
+                Q[1] -= lam * hess_d[1];
+                Q[HM_NX] -= lam * hess_d[2];
+                Q[HM_NX + 1] -= lam * hess_d[3];
+            }
+            qp->lg[n][j] = -g;
+            qp->soft[n][j] = 1;
+            qp->zl[n][j] = l1;
+            qp->Zl[n][j] = l2;
+            penalty += ocp_nlp_slack_penalty(g, l1, l2);
+        }
+    }
+    s->dyn_fresh = 0;
+    if (exact)
+        for (n = 0; n <= HM_N; n++) ocp_nlp_convexify_stage(qp, n, hm_fmax(reg, HM_R(1e-8)));
+    s->cost = cost + penalty;
+    s->cost_slack = penalty;
+    s->n_active = ng;
+}
+
+/* The measured state enters the QP as the offset of its fixed x_0 from the iterate's. */
+HM_FUNC void ocp_nlp_set_x0(hm_solver *s, const hm_input *in)
+{
+    int i;
+    for (i = 0; i < HM_NX; i++) s->qp.x0[i] = in->x0[i] - s->x[0][i];
+}

@@ -1,0 +1,180 @@
+/*
+ * ocp_nlp_out.c: what a solver step hands back, at its end: the NLP's KKT residuals, the plan, or
+ * the protective stop that replaces it, and the safety checks (the inputs before any solving, C1
+ * and C2 on the plan after) that decide which: the monitor's tests (monitor.h) applied here, where
+ * the solver's state is.
+ */
+#include "ocp_nlp_out.h"
+
+#include "monitor.h"
+#include "ocp_qp.h"
+
+/* KKT residuals of the NLP at the linearisation point with the multipliers in s->mult: exactly those
+ * of the QP of this linearisation at a zero step (its gradient is the NLP's, its constraints are the
+ * NLP's linearised here), soft rows carrying the slack they need at this point. */
+HM_FUNC void ocp_nlp_residuals(hm_solver *s, hm_output *out)
+{
+    hm_ocp_qp *qp = &s->qp;
+    hm_ocp_qp_sol *m = &s->mult;
+    hm_ocp_qp_res res;
+    hm_real gap = HM_R(0.0);
+    int n, j, i;
+    for (i = 0; i < HM_NX; i++) gap = hm_fmax(gap, hm_fabs(qp->x0[i]));
+    for (n = 0; n <= HM_N; n++)
+        for (j = 0; j < HM_NG; j++)
+            m->s[n][j] = (j < qp->ng[n] && qp->lg[n][j] > HM_R(0.0)) ? qp->lg[n][j] : HM_R(0.0);
+    ocp_qp_res_at_zero_step(qp, m, &res);
+    out->kkt_stat = res.stat;
+    out->kkt_eq = hm_fmax(res.eq, gap);
+    out->kkt_ineq = res.ineq;
+    out->kkt_comp = res.comp;
+}
+
+/* Smallest distance of the robot's path (nodes 0..N of s->x) to the present humans' current
+ * positions, HM_INF without humans. */
+static hm_real ocp_nlp_min_human_distance(const hm_solver *s, const hm_input *in)
+{
+    const int nh = ocp_nlp_clamp_humans(in);
+    hm_real best = HM_INF;   /* of the squared distances: one square root (it is monotonic) */
+    int n, j;
+    for (n = 0; n <= HM_N; n++) {
+        for (j = 0; j < nh; j++) {
+            const hm_real dx = s->x[n][0] - in->humans_now[j][0];
+            const hm_real dy = s->x[n][1] - in->humans_now[j][1];
+            const hm_real d2 = dx * dx + dy * dy;
+            if (d2 < best) best = d2;
+        }
+    }
+    return nh > 0 ? hm_sqrt(best) : HM_INF;
+}
+
+static int ocp_nlp_plan_finite(const hm_solver *s)
+{
+    hm_real acc = HM_R(0.0);
+    int n, i;
+    for (n = 0; n <= HM_N; n++)
+        for (i = 0; i < HM_NX; i++) acc += s->x[n][i] * HM_R(0.0);
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) acc += s->u[n][i] * HM_R(0.0);
+    return acc == HM_R(0.0); /* 0 * x is NaN for NaN or infinite x */
+}
+
+HM_FUNC void ocp_nlp_report(const hm_solver *s, const hm_input *in, hm_output *out)
+{
+    int n, i;
+    for (n = 0; n <= HM_N; n++)
+        for (i = 0; i < HM_NX; i++) out->x[n][i] = s->x[n][i];
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) out->u[n][i] = s->u[n][i];
+    out->u0[0] = s->u[0][0];
+    out->u0[1] = s->u[0][1];
+    out->command[0] = s->x[1][3];
+    out->command[1] = s->u[0][1];
+    out->cost = s->cost;
+    out->min_human_distance = ocp_nlp_min_human_distance(s, in);
+}
+
+/* Protective stop: brake to standstill within the acceleration bound, no turning; out's plan shows
+ * the braking. Without a usable measured speed the command is the hardest braking. After a failure
+ * (C1, unusable inputs) the next step starts cold, exactly as a fresh solver; after a C2 stop the
+ * plan is kept, so that the next steps go on improving it (a cold start would put the unsafe
+ * straight-line guess back every time). */
+HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output *out, int reason)
+{
+    const int params_ok = monitor_check_params(&s->params);
+    const hm_real a_min = params_ok ? s->params.a_bounds[0] : HM_R(-1.0);
+    const hm_real a_max = params_ok ? s->params.a_bounds[1] : HM_R(1.0);
+    const int x0_ok = params_ok && monitor_check_input(in, 1);
+    int n, i;
+    out->stop = 1;
+    out->stop_reason = reason;
+    if (!x0_ok) {
+        /* No trustworthy state (or bounds): full braking, a plan of zeros, nothing computed. */
+        for (n = 0; n <= HM_N; n++)
+            for (i = 0; i < HM_NX; i++) out->x[n][i] = HM_R(0.0);
+        for (n = 0; n < HM_N; n++) {
+            out->u[n][0] = a_min;
+            out->u[n][1] = HM_R(0.0);
+        }
+        out->min_human_distance = HM_INF;
+    } else {
+        hm_real A[HM_NX * HM_NX], B[HM_NX * HM_NU];
+        hm_real best = HM_INF;
+        int j;
+        for (i = 0; i < HM_NX; i++) out->x[0][i] = in->x0[i];
+        for (n = 0; n < HM_N; n++) {
+            out->u[n][0] = hm_fmin(hm_fmax(-out->x[n][3] / HM_R(HM_DT), a_min), a_max);
+            out->u[n][1] = HM_R(0.0);
+            hm_model_dynamics(out->x[n], out->u[n], out->x[n + 1], A, B);
+        }
+        for (n = 0; n <= HM_N; n++) {
+            for (j = 0; j < ocp_nlp_clamp_humans(in); j++) {
+                const hm_real dx = out->x[n][0] - in->humans_now[j][0];
+                const hm_real dy = out->x[n][1] - in->humans_now[j][1];
+                best = hm_fmin(best, hm_sqrt(dx * dx + dy * dy));
+            }
+        }
+        out->min_human_distance = best;
+    }
+    out->u0[0] = out->u[0][0];
+    out->u0[1] = HM_R(0.0);
+    out->command[0] = x0_ok ? out->x[1][3] : HM_R(0.0);
+    out->command[1] = HM_R(0.0);
+    s->prepared = 0;
+    if (reason != HM_STOP_UNSAFE_PLAN && reason != HM_STOP_HUMAN_TOO_CLOSE) s->warm = 0;
+}
+
+HM_FUNC void ocp_nlp_clear_output(hm_output *out)
+{
+    out->stop = 0;
+    out->stop_reason = HM_STOP_NONE;
+    out->status = HM_STATUS_SKIPPED;
+    out->qp_status = -1;
+    out->qp_iterations = 0;
+    out->sqp_iterations = 0;
+    out->qp_solves = 0;
+    out->cost = HM_R(0.0);
+    out->kkt_stat = HM_R(0.0);
+    out->kkt_eq = HM_R(0.0);
+    out->kkt_ineq = HM_R(0.0);
+    out->kkt_comp = HM_R(0.0);
+    out->min_human_distance = HM_INF;
+}
+
+/* The checks that come before any solving; returns the stop reason or HM_STOP_NONE. */
+HM_FUNC int ocp_nlp_check_before(const hm_solver *s, const hm_input *in)
+{
+    if (!monitor_check_params(&s->params)) return HM_STOP_INVALID_PARAMS;
+    if (!monitor_check_input(in, 1)) return HM_STOP_INVALID_INPUT;
+    if (monitor_distance_now(in) < s->params.d_h) return HM_STOP_HUMAN_TOO_CLOSE;
+    return HM_STOP_NONE;
+}
+
+static int ocp_nlp_keeps_distance(const hm_real *x, const hm_input *in, hm_real limit)
+{
+    const int nh = ocp_nlp_clamp_humans(in);
+    int j;
+    for (j = 0; j < nh; j++) {
+        const hm_real dx = x[0] - in->humans_now[j][0];
+        const hm_real dy = x[1] - in->humans_now[j][1];
+        if (dx * dx + dy * dy < limit * limit) return 0;
+    }
+    return 1;
+}
+
+/* C2 on the plan: its nodes 1..N against the humans' current positions, and the state the robot
+ * really reaches after applying u0 for one interval (the model from the measured x0: the plan's
+ * own x_1 is the QP's linear prediction of it). The allowance covers the distance smoothing
+ * (eps^2 / (2 d_h) ~ 1e-6 m) and the QP tolerance. */
+HM_FUNC int ocp_nlp_check_plan(const hm_solver *s, const hm_input *in)
+{
+    const hm_real limit = s->params.d_h - HM_R(1e-5);
+    hm_real x1[HM_NX], A[HM_NX * HM_NX], B[HM_NX * HM_NU];
+    int n;
+    if (!ocp_nlp_plan_finite(s)) return HM_STOP_NONFINITE;
+    for (n = 1; n <= HM_N; n++)
+        if (!ocp_nlp_keeps_distance(s->x[n], in, limit)) return HM_STOP_UNSAFE_PLAN;
+    hm_model_dynamics(in->x0, s->u[0], x1, A, B);
+    if (!ocp_nlp_keeps_distance(x1, in, limit)) return HM_STOP_UNSAFE_PLAN;
+    return HM_STOP_NONE;
+}

@@ -1,0 +1,137 @@
+/*
+ * ocp_nlp_step.c: the step of an SQP iteration from its QP's solution: the full step (real-time
+ * iteration) or a backtracking line search on the l1 merit (full SQP, and the real-time iteration
+ * with line_search); the QP's multipliers become the NLP's. The linearisation point is kept in
+ * x_base, u_base for the step's duration.
+ */
+#include "ocp_nlp_step.h"
+
+#include "ocp_nlp_lin.h"
+#include "ocp_nlp_screen.h"
+
+/* Iterate = base + alpha * QP step (base: the linearisation point, kept in x_base/u_base). */
+static void ocp_nlp_step_from_base(hm_solver *s, hm_real alpha)
+{
+    int n, i;
+    const hm_ocp_qp_sol *d = &s->qp_sol;
+    s->dyn_fresh = 0;
+    for (n = 0; n <= HM_N; n++)
+        for (i = 0; i < HM_NX; i++) s->x[n][i] = s->x_base[n][i] + alpha * d->x[n][i];
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) s->u[n][i] = s->u_base[n][i] + alpha * d->u[n][i];
+}
+
+static void ocp_nlp_save_base(hm_solver *s)
+{
+    int n, i;
+    for (n = 0; n <= HM_N; n++)
+        for (i = 0; i < HM_NX; i++) s->x_base[n][i] = s->x[n][i];
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) s->u_base[n][i] = s->u[n][i];
+}
+
+static void ocp_nlp_copy(hm_real *restrict dst, const hm_real *restrict src, int len)
+{
+    int i;
+    for (i = 0; i < len; i++) dst[i] = src[i];
+}
+
+/* The QP's multipliers become the NLP's. Their primal part stays zero (ocp_qp_sol_set_zero at every
+ * cold start; never written), the slacks are set by ocp_nlp_residuals: neither is copied. */
+static void ocp_nlp_take_multipliers(hm_solver *s)
+{
+    hm_ocp_qp_sol *m = &s->mult;
+    const hm_ocp_qp_sol *q = &s->qp_sol;
+    ocp_nlp_copy(&m->pi[0][0], &q->pi[0][0], HM_N * HM_NX);
+    ocp_nlp_copy(&m->lam_lbx[0][0], &q->lam_lbx[0][0], (HM_N + 1) * HM_NX);
+    ocp_nlp_copy(&m->lam_ubx[0][0], &q->lam_ubx[0][0], (HM_N + 1) * HM_NX);
+    ocp_nlp_copy(&m->lam_lbu[0][0], &q->lam_lbu[0][0], HM_N * HM_NU);
+    ocp_nlp_copy(&m->lam_ubu[0][0], &q->lam_ubu[0][0], HM_N * HM_NU);
+    ocp_nlp_copy(&m->lam_lg[0][0], &q->lam_lg[0][0], (HM_N + 1) * HM_NG);
+    ocp_nlp_copy(&m->lam_ls[0][0], &q->lam_ls[0][0], (HM_N + 1) * HM_NG);
+}
+
+/* Solve the QP; when usable, take the full step (real-time iteration). */
+HM_FUNC int ocp_nlp_qp_step(hm_solver *s, int shifted, int *qp_iter)
+{
+    const int status = ocp_nlp_qp_solve(s, s->params.qp_tol, 0, shifted, qp_iter);
+    if (!ocp_nlp_qp_usable(status)) return status;
+    ocp_nlp_save_base(s);
+    ocp_nlp_step_from_base(s, HM_R(1.0));
+    ocp_nlp_take_multipliers(s);
+    return status;
+}
+
+/* l1 merit of the iterate: objective with the soft-row penalties + mu * (|dynamics gaps|_1 +
+ * |x_0 - measured x0|_1). Bounds are linear, so every step of the line search keeps them. */
+static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
+{
+    const hm_params *p = &s->params;
+    const int nh = ocp_nlp_clamp_humans(in);
+    const int ng = nh + (in->has_obstacle ? 1 : 0);
+    hm_real merit = HM_R(0.0), gaps = HM_R(0.0);
+    int n, i, j;
+    for (i = 0; i < HM_NX; i++) gaps += hm_fabs(s->x[0][i] - in->x0[i]);
+    for (n = 0; n <= HM_N; n++) {
+        const hm_real *x = s->x[n];
+        hm_real l, gx[HM_NX], hx[HM_NX * HM_NX];
+        if (n < HM_N) {
+            hm_real gu[HM_NU], hu[HM_NU * HM_NU], x_next[HM_NX], A[HM_NX * HM_NX], B[HM_NX * HM_NU];
+            hm_model_dynamics(x, s->u[n], x_next, A, B);
+            for (i = 0; i < HM_NX; i++) gaps += hm_fabs(x_next[i] - s->x[n + 1][i]);
+            hm_model_cost_stage(x, s->u[n], in->goal, p->w_goal, p->w_control, &l, gx, gu, hx, hu);
+        } else {
+            hm_model_cost_terminal(x, in->goal, p->w_goal_terminal, &l, gx, hx);
+        }
+        merit += l;
+        for (j = 0; j < nh; j++) {
+            hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP];
+            hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
+            merit += f;
+        }
+        if (n == 0) continue;
+        for (j = 0; j < ng; j++) {
+            const int human = j < nh;
+            hm_real g, jac[HM_NP], hess_d[HM_NP * HM_NP];
+            hm_model_distance_constraint(x, human ? in->humans_now[j] : in->obstacle, human ? &p->d_h : &p->d_s,
+                                         &g, jac, hess_d);
+            merit += ocp_nlp_slack_penalty(g, human ? p->human_slack_l1 : p->slack_l1,
+                                           human ? p->human_slack_l2 : p->slack_l2);
+        }
+    }
+    return merit + mu * gaps;
+}
+
+/* Full SQP step with a backtracking line search on the l1 merit (Armijo on the decrease that the
+ * QP model predicts); mu grows to stay above the dynamics multipliers, as exactness requires. */
+HM_FUNC int ocp_nlp_qp_line_search_step(hm_solver *s, const hm_input *in, hm_real tol, int shifted,
+                                       int *qp_iter)
+{
+    /* The QP must be solved at least as tightly as the SQP is asked to converge. */
+    const int status = ocp_nlp_qp_solve(s, hm_fmin(s->params.qp_tol, HM_R(0.1) * tol), 1, shifted, qp_iter);
+    hm_real gaps = HM_R(0.0), pi_max = HM_R(0.0), merit0, predicted, alpha = HM_R(1.0);
+    int n, i;
+    if (!ocp_nlp_qp_usable(status)) return status;
+    for (i = 0; i < HM_NX; i++) gaps += hm_fabs(s->qp.x0[i]);
+    for (n = 0; n < HM_N; n++) {
+        for (i = 0; i < HM_NX; i++) {
+            gaps += hm_fabs(s->qp.b[n][i]);
+            pi_max = hm_fmax(pi_max, hm_fabs(s->qp_sol.pi[n][i]));
+        }
+    }
+    s->merit_mu = hm_fmax(s->merit_mu, HM_R(2.0) * pi_max + HM_R(1.0));
+    merit0 = s->cost + s->merit_mu * gaps;
+    /* The QP model of the merit after the full step: smooth objective + QP objective (its slack
+     * penalties included) and linearised gaps closed. */
+    predicted = merit0 - (s->cost - s->cost_slack + s->ipm_ws.out.res.obj);
+    ocp_nlp_save_base(s);
+    for (;;) {
+        ocp_nlp_step_from_base(s, alpha);
+        if (alpha <= HM_R(1e-4)) break;
+        if (ocp_nlp_merit(s, in, s->merit_mu) <= merit0 - HM_R(1e-4) * alpha * hm_fmax(predicted, HM_R(0.0)))
+            break;
+        alpha *= HM_R(0.5);
+    }
+    ocp_nlp_take_multipliers(s);
+    return status;
+}

@@ -1,0 +1,53 @@
+/*
+ * ocp_qp_ipm_common.h: what the files of the interior-point method (ocp_qp_ipm*.c) share: the
+ * checks of the sizes that ocp_qp_ipm_types.h writes out, max/min without libm, the lane count of
+ * the soft rows' passes, and the stage Hessian product that the stage measures, the certificates
+ * and the polish inline. No state: constants and an inline kernel.
+ */
+#ifndef OCP_QP_IPM_COMMON_H
+#define OCP_QP_IPM_COMMON_H
+
+#include "hm_common.h"
+#include "ocp_qp_kkt.h"
+
+/* ocp_qp_ipm_types.h writes the sizes out: the padded stage count of ocp_qp_ipm_bounds must be
+ * HM_QP_NNP, the length of the row list of ocp_qp_ipm_rows HM_QP_NR */
+typedef char ocp_qp_ipm_nr_matches[sizeof(((hm_ocp_qp_ipm_rows *)0)->ss) == HM_QP_NR * sizeof(hm_real) ? 1 : -1];
+typedef char ocp_qp_ipm_nnp_matches[sizeof(((hm_ocp_qp_ipm_bounds *)0)->v[0]) == HM_QP_NNP * sizeof(hm_real) ? 1 : -1];
+
+/* max/min without libm's calls (whose NaN rule is not needed here: NaN is caught on the sums) */
+#define OCP_QP_IPM_MAX(a, b) ((a) > (b) ? (a) : (b))
+#define OCP_QP_IPM_MIN(a, b) ((a) < (b) ? (a) : (b))
+#define OCP_QP_IPM_ABS(a) ((a) < HM_R(0.0) ? -(a) : (a))
+
+/* The soft rows' passes take the list eight rows at a time (ocp_qp_ipm_rows). */
+#define OCP_QP_IPM_LANES 8
+
+/* y = H_n x for the (scaled) cost Hessian [R S; S' Q] of stage n on (u, x); parts absent at stage 0
+ * (x) and stage N (u) are zero in the stage block and in x. */
+HM_KERNEL void ocp_qp_ipm_hess_mul(const hm_ocp_qp_ipm_stage *restrict sn, const hm_real *restrict x,
+                                 hm_real *restrict y)
+{
+    const hm_real *restrict R = sn->R;
+    const hm_real *restrict S = sn->S;
+    const hm_real *restrict Q = sn->Q;
+    const hm_real u0 = x[0], u1 = x[1];
+    hm_real yx[HM_NX];
+    int i, k;
+    y[0] = R[0] * u0 + R[2] * u1;
+    y[1] = R[1] * u0 + R[3] * u1;
+    for (i = 0; i < HM_NX; i++) yx[i] = Q[i] * x[HM_NU];
+    for (k = 1; k < HM_NX; k++) {
+        const hm_real xk = x[HM_NU + k];
+        for (i = 0; i < HM_NX; i++) yx[i] += Q[i + k * HM_NX] * xk;
+    }
+    for (k = 0; k < HM_NX; k++) {
+        const hm_real *restrict sk = &S[k * HM_NU];
+        y[0] += sk[0] * x[HM_NU + k];
+        y[1] += sk[1] * x[HM_NU + k];
+        yx[k] += sk[0] * u0 + sk[1] * u1;
+    }
+    for (i = 0; i < HM_NX; i++) y[HM_NU + i] = yx[i];
+}
+
+#endif /* OCP_QP_IPM_COMMON_H */

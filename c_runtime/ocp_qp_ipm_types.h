@@ -1,0 +1,171 @@
+/*
+ * ocp_qp_ipm_types.h: the sized types of the interior-point solver: one stage's blocks, the bound
+ * pairs and the soft-row list of all stages, a vector in its layout, the iterate kept for the warm
+ * start, and the workspace that holds them (or, in a union, the fallback's: ocp_qp_hsde_types.h).
+ * Set up by every solve; only the warm start outlives one.
+ * No include guard: instantiated once per solver under the HM_NS / HM_REAL / HM_N / HM_NG contract of
+ * hm_types.h, which includes it.
+ */
+#include "hm_common.h"
+
+/* ------------------------------------------------------------------------------------------------
+ * ocp_qp_ipm: the interior-point solver of ocp_qp (ocp_qp_ipm.h, ocp_qp_kkt.h, ocp_qp.h).
+ *
+ * A primal-dual (infeasible-start, Mehrotra predictor-corrector) method. Its inequalities are kept
+ * per stage in fixed-size blocks of three families, so that every loop has a compile-time bound or
+ * visits only what is present:
+ *   bound pairs   a component of (u, x) with a lower and/or an upper bound somewhere on the horizon:
+ *                 one slot per such component for all stages, stored stage-major (ocp_qp_ipm_bounds)
+ *                 so that the passes treat eight stages at once in vector lanes; a side absent at a
+ *                 stage has sign 0 and a neutral state;
+ *   soft rows     D' p + s >= lg with its slack s >= 0 (s is its own slack: no second slack);
+ *   hard rows     D' p >= lg.
+ * Rows are processed two at a time (2-wide SIMD where the compiler can); a stage with an odd count
+ * pads its family with one neutral row (D = 0, state reset to 1, masked out of every sum).
+ * The arrays below are sized HM_QP_NGP = HM_NG rounded up to even, written out since this file has
+ * no include guard.
+ * ---------------------------------------------------------------------------------------------- */
+
+/* One stage of the solver: its inequality families, its part of the iterate and of the direction,
+ * and its part of the Newton system. Stage n carries (u_n, x_n) as one 6-vector ux (u first; u of
+ * stage HM_N and x of stage 0 unused), and y_n, the multiplier of the dynamics from n to n + 1. */
+typedef struct HM_NS(ocp_qp_ipm_stage) {
+    /* structure, set up by every solve */
+    int ns, nh;                       /* soft rows, hard rows */
+    int soff;                         /* soft row j of the stage is row soff + j of ocp_qp_ipm_rows */
+    int ns2, nh2;                     /* the same rounded up to even (rows go in pairs) */
+    int a_id;                         /* 1: the first two columns of A_n are e_0, e_1 */
+    int ab_int;                       /* 1: a_id, and rows 2 and 3 of [A_n B_n] are two integrators' (the
+                                         robot's; ocp_qp_kkt.c: ocp_qp_kkt_factor_stage_integrators) */
+    unsigned char hrow[(HM_NG + 1) / 2 * 2];   /* QP row of hard row j */
+    /* cost times the cost scale (stage 0: x_0 terms folded into q), dynamics offset (stage 0:
+     * b_0 + A_0 x_0); column-major like ocp_qp */
+    HM_REAL R[HM_NU * HM_NU], S[HM_NU * HM_NX], Q[HM_NX * HM_NX], q[HM_NU + HM_NX], beq[HM_NX];
+
+    /* hard rows: -d' p + t = -lg */
+    HM_REAL hd0[(HM_NG + 1) / 2 * 2], hd1[(HM_NG + 1) / 2 * 2], hlg[(HM_NG + 1) / 2 * 2];
+    HM_REAL hlive[(HM_NG + 1) / 2 * 2];
+    HM_REAL ht[(HM_NG + 1) / 2 * 2], hz[(HM_NG + 1) / 2 * 2];
+    HM_REAL hdt[(HM_NG + 1) / 2 * 2], hdz[(HM_NG + 1) / 2 * 2];
+    HM_REAL hw[(HM_NG + 1) / 2 * 2], hti[(HM_NG + 1) / 2 * 2], hzi[(HM_NG + 1) / 2 * 2];
+    HM_REAL hdel[(HM_NG + 1) / 2 * 2];
+
+    /* iterate and step of the stage; ry: right-hand side of the dynamics n -> n + 1 in the Newton
+     * system (minus their residual) */
+    HM_REAL ux[HM_NU + HM_NX], y[HM_NX], dux[HM_NU + HM_NX], dy[HM_NX], ry[HM_NX];
+    /* the stationarity residual P v + q + A' w of (u, x); it and ry follow the iterate by the
+     * recurrence r <- (1 - alpha) r between exact evaluations (ocp_qp_ipm_pass_a.c) */
+    HM_REAL rv[HM_NU + HM_NX];
+    /* Newton system: the families condensed into the stage (diagonal, (px, py) block), gradients of
+     * the predictor and the two parts of the corrector's change, and the Riccati factor */
+    HM_REAL Hd[HM_NU + HM_NX], Hpp[3];
+    HM_REAL ha[HM_NU + HM_NX], hdl[HM_NU + HM_NX], hmu[HM_NU + HM_NX];
+    HM_REAL P[HM_NX * HM_NX], p[HM_NX], Pry[HM_NX];
+    HM_REAL Ld[3];                    /* LDL' of the input block: 1 / d0, l10, 1 / d1 */
+    HM_REAL Kx[HM_NU * HM_NX];        /* L^-1 (input-state block), row j at Kx[j * HM_NX] */
+    HM_REAL F[HM_NX * HM_NX];         /* closed-loop dynamics A - B G of the step's feedback u = -G x + .. */
+    HM_REAL yk[HM_NU];
+} HM_NS(ocp_qp_ipm_stage);
+
+/* The bound pairs of all stages, stage-major: slot k (< nbp) is component bc[k] of (u, x), side 0
+ * the lower and side 1 the upper bound, sign * ux[c] + t = b (sign -1 and b = -lb, sign +1 and
+ * b = ub; an absent side has sign 0, b = 1 and stays at t = z = 1). The stages run to HM_N + 1
+ * rounded up to a multiple of 8 (HM_QP_NNP of ocp_qp_kkt.h), those past HM_N absent on both sides. */
+typedef struct HM_NS(ocp_qp_ipm_bounds) {
+    int nbp;
+    unsigned char bc[HM_NU + HM_NX];
+    HM_REAL sg[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* sign */
+    HM_REAL b[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];
+    HM_REAL t[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];     /* slack */
+    HM_REAL z[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];     /* multiplier */
+    HM_REAL dt[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* step */
+    HM_REAL dz[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];
+    HM_REAL w[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];     /* z / t, capped */
+    HM_REAL ti[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* 1 / t */
+    HM_REAL zi[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* 1 / z */
+    HM_REAL rho[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];   /* predictor right-hand side */
+    HM_REAL del[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];   /* predictor dt dz */
+    /* per slot and stage: ux[c] of the iterate and of the step (pass C's predictor step until pass
+     * E writes the corrector's); the pair's parts of the Newton diagonal and of the gradients ha,
+     * hmu and hdl */
+    HM_REAL v[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL dv[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL Hd[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL hf[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL hmu[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL hdl[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+} HM_NS(ocp_qp_ipm_bounds);
+
+/* The soft rows of all stages in one list: stage after stage, each stage's ns rows padded to an even
+ * count (ns2, the padding row absent), the list padded to a multiple of 8 with absent rows (live 0,
+ * d = 0, at the neutral state s = t = z = zs = 1; HM_QP_NR of ocp_qp_kkt.h). Row r of stage n:
+ * -(d' p + s) + t = -lg, s >= 0, cost zl s + Zl s^2 / 2 (times the cost scale). The passes of the
+ * interior-point method run over the list eight rows at a time, with d' p and d' dp of each row's
+ * stage in gp and gd. sdr, sdsb (from pass C to pass E) and se (the general solve's) are free in
+ * pass A, which keeps its per-row terms there until the stages have summed them (ocp_qp_ipm_pass_a.c). */
+/* one value per row of the list */
+typedef HM_REAL HM_NS(ocp_qp_ipm_row_vec)[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
+typedef struct HM_NS(ocp_qp_ipm_rows) {
+    int nr;                           /* rows in the list, padding rows of the stages included */
+    unsigned char srow[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];   /* QP row within its stage */
+    HM_NS(ocp_qp_ipm_row_vec) sd0, sd1, slg, szl, sZl, slive;
+    HM_NS(ocp_qp_ipm_row_vec) ss, st;        /* slack s, row slack t */
+    HM_NS(ocp_qp_ipm_row_vec) sz, szs;       /* multipliers of the row, of s >= 0 */
+    HM_NS(ocp_qp_ipm_row_vec) sds, sdt, sdz, sdzs;
+    HM_NS(ocp_qp_ipm_row_vec) swr, sws;      /* weights z/t, zs/s */
+    HM_NS(ocp_qp_ipm_row_vec) shi;           /* 1 / (Zl + wr + ws) */
+    HM_NS(ocp_qp_ipm_row_vec) sti, szi;      /* 1/t, 1/z */
+    HM_NS(ocp_qp_ipm_row_vec) ssi, szsi;     /* 1/s, 1/zs */
+    HM_NS(ocp_qp_ipm_row_vec) srs;           /* stationarity residual of s */
+    HM_NS(ocp_qp_ipm_row_vec) sdr, sdsb;     /* dt dz, ds dzs of the predictor */
+    HM_NS(ocp_qp_ipm_row_vec) se;            /* general solve: slack step at a zero position step */
+    HM_NS(ocp_qp_ipm_row_vec) gp, gd;        /* d' p at the iterate's position, d' dp at the step's */
+} HM_NS(ocp_qp_ipm_rows);
+
+/* A vector in the solver's layout (the Newton system's unknowns or right-hand side), used by the
+ * general solve of ocp_qp_kkt.h (tests, polish): per stage ux, the soft slacks by soft row, y, and
+ * one entry per inequality: bound lanes, soft rows, their s >= 0, hard rows. */
+typedef struct HM_NS(ocp_qp_ipm_vec) {
+    HM_REAL ux[HM_N + 1][HM_NU + HM_NX];
+    HM_REAL s[HM_N + 1][(HM_NG + 1) / 2 * 2];
+    HM_REAL y[HM_N][HM_NX];
+    HM_REAL zb[HM_N + 1][HM_NU + HM_NX][2];
+    HM_REAL zr[HM_N + 1][(HM_NG + 1) / 2 * 2];
+    HM_REAL zs[HM_N + 1][(HM_NG + 1) / 2 * 2];
+    HM_REAL zh[HM_N + 1][(HM_NG + 1) / 2 * 2];
+} HM_NS(ocp_qp_ipm_vec);
+
+/* An iterate kept by a solve for the next one's start (arg->warm_start, warm_mu): its slacks and
+ * multipliers (unscaled) by stage and (u, x) component or QP row, so that the next QP may have
+ * other bounds and rows. */
+typedef struct HM_NS(ocp_qp_ipm_warm) {
+    int ready;                                   /* 1: the last solve kept one */
+    HM_REAL bt[HM_N + 1][HM_NU + HM_NX][2];      /* bound sides (lower, upper): slack, 0 if absent */
+    HM_REAL bz[HM_N + 1][HM_NU + HM_NX][2];      /* and multiplier */
+    HM_REAL rt[HM_N + 1][HM_NG], rz[HM_N + 1][HM_NG];     /* rows: slack, multiplier */
+    HM_REAL rs[HM_N + 1][HM_NG], rzs[HM_N + 1][HM_NG];    /* soft rows: s, multiplier of s >= 0 */
+    unsigned char kind[HM_N + 1][HM_NG];         /* 0 absent, 1 soft, 2 hard */
+} HM_NS(ocp_qp_ipm_warm);
+
+/* All memory of a solve. Only the first block is meant for the caller. */
+typedef struct HM_NS(ocp_qp_ipm_ws) {
+    HM_NS(ocp_qp_outcome) out;        /* of the last solve */
+    HM_NS(ocp_qp_ipm_warm) warm;      /* kept for the next solve (outside the fallback's memory) */
+
+    /* the problem as the solver sees it, and its iterate */
+    int m;                            /* inequalities (present bound sides, rows, s >= 0) */
+    HM_REAL cost_scale;               /* the cost is solved scaled by this (ocp_qp_ipm_setup.c) */
+    HM_REAL w_max;                    /* cap of the weights z / t (ocp_qp_ipm_setup.c) */
+    HM_REAL norm_q, norm_b;
+    int fallback;                     /* the solution came from the fallback solver (ocp_qp_hsde.h) */
+    /* the stages, and two vectors for the polish and the general solve; or the fallback's memory */
+    union {
+        struct {
+            HM_NS(ocp_qp_ipm_stage) st[HM_N + 1];
+            HM_NS(ocp_qp_ipm_bounds) bd;
+            HM_NS(ocp_qp_ipm_rows) sr;
+            HM_NS(ocp_qp_ipm_vec) va, vb;
+        } f;
+        HM_NS(ocp_qp_hsde_ws) hsde;
+    } u;
+} HM_NS(ocp_qp_ipm_ws);
