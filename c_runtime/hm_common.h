@@ -12,6 +12,8 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "hm_status.h"
+
 /* The robot model is fixed by the product: unicycle state [px, py, theta, v], control [a, omega].
  * General (distance) rows touch only the position [px, py]. */
 #define HM_NX 4
@@ -67,14 +69,8 @@
 /* A bound whose magnitude reaches HM_INF is absent (no row is created for it). */
 #define HM_IS_INF(x) (hm_fabs(x) >= HM_INF)
 
-/* Status of a QP solve. Fixed values: they are part of the public C and Python API. */
-enum hm_qp_status {
-    HM_QP_SOLVED = 0,      /* converged to the requested tolerance */
-    HM_QP_MAX_ITER = 1,    /* iteration limit reached before convergence */
-    HM_QP_INFEASIBLE = 2,  /* no point satisfies the hard constraints */
-    HM_QP_NUMERICAL = 3,   /* factorisation failed or the iterates stopped making progress */
-    HM_QP_NONFINITE = 4,   /* NaN or Inf in the data or produced during the solve */
-    HM_QP_TIMEOUT = 5      /* the caller's stop hook fired (deadline) */
-};
+/* Status of a QP solve: HM_QP_SOLVED, HM_QP_MAX_ITER, ... (rows of hm_status.h, their single
+ * source; fixed values, part of the public C and Python API). */
+enum hm_qp_status { HM_QP_STATUS_TABLE(HM_STATUS_ENUM_ROW) };
 
 #endif /* HM_COMMON_H */

@@ -54,40 +54,10 @@ HM_FUNC int monitor_check_input(const hm_input *in, int check_x0)
     return monitor_predictions_ok(in);
 }
 
-static int monitor_nonneg(hm_real v)
-{
-    return monitor_finite(v) && v >= HM_R(0.0);
-}
-
-static int monitor_interval_ok(const hm_real *b)
-{
-    /* lower < upper and 0 inside: the protective stop must be feasible */
-    return monitor_finite(b[0]) && monitor_finite(b[1]) && b[0] < b[1] && b[0] <= HM_R(0.0) && b[1] >= HM_R(0.0);
-}
-
-/* 1 when the runtime parameters are usable (the rules of the spec). */
+/* 1 when the runtime parameters keep the rules of the parameter table (see monitor.h). */
 HM_FUNC int monitor_check_params(const hm_params *p)
 {
-    int i;
-    for (i = 0; i < HM_NX; i++)
-        if (!monitor_nonneg(p->w_goal[i]) || !monitor_nonneg(p->w_goal_terminal[i])) return 0;
-    for (i = 0; i < HM_NU; i++)
-        if (!monitor_nonneg(p->w_control[i])) return 0;
-    if (!monitor_nonneg(p->q) || !monitor_nonneg(p->d_th) || !monitor_nonneg(p->d_h) || !monitor_nonneg(p->d_s))
-        return 0;
-    if (!monitor_finite(p->kappa) || p->kappa <= HM_R(0.0) || p->kappa > HM_R(1e3)) return 0;
-    if (!monitor_nonneg(p->slack_l1) || !monitor_nonneg(p->slack_l2)) return 0;
-    if (!monitor_nonneg(p->human_slack_l1) || !monitor_nonneg(p->human_slack_l2)) return 0;
-    if (!monitor_interval_ok(p->v_bounds) || !monitor_interval_ok(p->a_bounds) || !monitor_interval_ok(p->omega_bounds))
-        return 0;
-    if (!monitor_nonneg(p->regularization)) return 0;
-    if (!monitor_finite(p->qp_tol) || p->qp_tol <= HM_R(0.0)) return 0;
-    if (!monitor_finite(p->deadline_ms) || p->deadline_ms <= HM_R(0.0)) return 0;
-    if (p->qp_max_iter < 1 || p->qp_max_iter > 1000) return 0;
-    if (p->line_search != 0 && p->line_search != 1) return 0;
-    if (p->row_screening != 0 && p->row_screening != 1) return 0;
-    if (p->exact_hessian != 0 && p->exact_hessian != 1) return 0;
-    return 1;
+    return hm_params_check(p) == 0;
 }
 
 /* Distance from the robot now to the closest present human (HM_INF when none). */
@@ -107,22 +77,7 @@ HM_FUNC hm_real monitor_distance_now(const hm_input *in)
 HM_FUNC const char *monitor_stop_reason_message(int reason)
 {
     switch (reason) {
-    case HM_STOP_NONE:
-        return "no stop";
-    case HM_STOP_INVALID_INPUT:
-        return "protective stop: non-finite or absurd input (state, goal, humans, predictions or obstacle)";
-    case HM_STOP_INVALID_PARAMS:
-        return "protective stop: runtime parameters non-finite or out of range";
-    case HM_STOP_DEADLINE:
-        return "protective stop (C1): the solver missed its deadline";
-    case HM_STOP_QP_FAILED:
-        return "protective stop (C1): the QP was not solved";
-    case HM_STOP_NONFINITE:
-        return "protective stop (C1): non-finite number in the solution";
-    case HM_STOP_HUMAN_TOO_CLOSE:
-        return "protective stop (C2): a human is within d_h of the robot";
-    case HM_STOP_UNSAFE_PLAN:
-        return "protective stop (C2): the planned path comes within d_h of a human";
+        HM_STOP_REASON_TABLE(HM_STATUS_CASE_ROW)
     default:
         return "unknown stop reason";
     }

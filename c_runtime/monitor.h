@@ -21,18 +21,14 @@
 #include "hm_common.h"
 #include "ocp_nlp_common.h" /* hm_input, hm_params */
 
-/* Why a protective stop is in force. Fixed values: part of the public C and Python API. */
-enum hm_stop_reason {
-    HM_STOP_NONE = 0,
-    HM_STOP_INVALID_INPUT = 1,    /* non-finite or absurd state, goal, humans, predictions or obstacle */
-    HM_STOP_INVALID_PARAMS = 2,   /* runtime parameters non-finite or out of range */
-    HM_STOP_DEADLINE = 3,         /* C1: the step did not finish within deadline_ms */
-    HM_STOP_QP_FAILED = 4,        /* C1: the QP was not solved (limit, infeasible, numerical failure) */
-    HM_STOP_NONFINITE = 5,        /* C1: a non-finite number in the solution */
-    HM_STOP_HUMAN_TOO_CLOSE = 6,  /* C2: the robot already is within d_h of a human */
-    HM_STOP_UNSAFE_PLAN = 7       /* C2: the planned path comes within d_h of a human's current position */
-};
-#define HM_STOP_REASON_COUNT 8
+/* Why a protective stop is in force: HM_STOP_NONE, HM_STOP_INVALID_INPUT, ... (rows of hm_status.h,
+ * their single source; fixed values, part of the public C and Python API). */
+enum hm_stop_reason { HM_STOP_REASON_TABLE(HM_STATUS_ENUM_ROW) };
+#define HM_STOP_REASON_COUNT (0 HM_STOP_REASON_TABLE(HM_STATUS_COUNT_ROW))
+
+/* The rules of the runtime parameters are the generator's table (humanmpc.codegen.params): the
+ * including translation unit supplies them as hm_params_check(p), 0 when every rule holds, else 1 +
+ * the index of the first broken one (the generated <name>_params_check). */
 
 /* Magnitudes beyond which an input is absurd rather than merely unusual. */
 #define HM_MONITOR_MAX_POSITION HM_R(1.0e5)   /* m */

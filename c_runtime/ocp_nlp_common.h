@@ -33,13 +33,12 @@ typedef HM_NS(output) hm_output;
 typedef HM_NS(clock_fn) hm_clock_fn;
 typedef HM_NS(solver) hm_solver;
 
-/* Status of a solver step. Fixed values: part of the public C and Python API. */
-enum hm_status {
-    HM_STATUS_OK = 0,        /* RTI: QP solved, step taken. Full SQP: converged to the tolerance */
-    HM_STATUS_MAX_ITER = 1,  /* RTI: QP stopped at its iteration limit (step taken). SQP: not converged */
-    HM_STATUS_QP_FAILED = 2, /* the QP failed (see qp_status): no step taken, next step starts cold */
-    HM_STATUS_SKIPPED = 3    /* nothing solved: inputs unusable or a human already too close (see stop) */
-};
+/* Status of a solver step (rows of hm_status.h; fixed values, part of the public C and Python API).
+ * HM_STATUS_OK: RTI: QP solved, step taken; full SQP: converged to the tolerance. HM_STATUS_MAX_ITER:
+ * RTI: QP stopped at its iteration limit (step taken); SQP: not converged. HM_STATUS_QP_FAILED: the QP
+ * failed (see qp_status): no step taken, the next step starts cold. HM_STATUS_SKIPPED: nothing solved:
+ * inputs unusable or a human already too close (see stop). */
+enum hm_status { HM_STATUS_TABLE(HM_STATUS_ENUM_ROW) };
 
 /* The present humans of the input, their count clamped to 0..HM_NG - 1. */
 HM_FUNC int ocp_nlp_clamp_humans(const hm_input *in);

@@ -129,7 +129,7 @@ HM_FUNC void ocp_nlp_clear_output(hm_output *out)
     out->stop = 0;
     out->stop_reason = HM_STOP_NONE;
     out->status = HM_STATUS_SKIPPED;
-    out->qp_status = -1;
+    out->qp_status = HM_QP_NOT_RUN;
     out->qp_iterations = 0;
     out->sqp_iterations = 0;
     out->qp_solves = 0;

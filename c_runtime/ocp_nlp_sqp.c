@@ -125,14 +125,7 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
 HM_FUNC const char *ocp_nlp_status_message(int status)
 {
     switch (status) {
-    case HM_STATUS_OK:
-        return "solved";
-    case HM_STATUS_MAX_ITER:
-        return "iteration limit reached before the tolerance";
-    case HM_STATUS_QP_FAILED:
-        return "the QP failed; no step taken";
-    case HM_STATUS_SKIPPED:
-        return "nothing solved: a protective stop was decided before solving";
+        HM_STATUS_TABLE(HM_STATUS_CASE_ROW)
     default:
         return "unknown status";
     }

@@ -104,18 +104,7 @@ HM_FUNC void ocp_qp_ipm_arg_set_default(hm_ocp_qp_ipm_arg *arg)
 HM_FUNC const char *ocp_qp_status_message(int status)
 {
     switch (status) {
-    case HM_QP_SOLVED:
-        return "QP solved";
-    case HM_QP_MAX_ITER:
-        return "QP iteration limit reached before convergence";
-    case HM_QP_INFEASIBLE:
-        return "QP infeasible: no point satisfies the hard constraints";
-    case HM_QP_NUMERICAL:
-        return "QP numerical failure: singular Newton system, no progress, or unbounded";
-    case HM_QP_NONFINITE:
-        return "QP data or iterates not finite (NaN/Inf, or ng out of range)";
-    case HM_QP_TIMEOUT:
-        return "QP stopped by the deadline hook";
+        HM_QP_STATUS_TABLE(HM_STATUS_CASE_ROW)
     default:
         return "unknown QP status";
     }

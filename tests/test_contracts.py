@@ -115,7 +115,7 @@ def test_status_codes_agree_in_the_header_the_c_messages_and_the_python_enums(pa
                                                                                paper_dir: Path) -> None:
     header = (paper_dir / f"{paper.name}.h").read_text()
     defined = {m.group(1): int(m.group(2))
-               for m in re.finditer(rf"#define {paper.name.upper()}_([A-Z0-9_]+) (-?\d+) ", header)}
+               for m in re.finditer(rf"#define {paper.name.upper()}_([A-Z0-9_]+) (-?\d+)\b", header)}
     for enum, key, c_message in ((QpStatus, "qp_status", paper.qp_status_message), (Status, "status",
                                  paper.status_message), (StopReason, "stop_reason", paper.stop_reason_message)):
         rows = status_tables()[key]
