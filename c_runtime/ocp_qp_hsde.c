@@ -6,6 +6,7 @@
  * the primal-dual method's stage blocks otherwise occupy (ocp_qp_ipm_ws.u).
  */
 #include "ocp_qp.h"
+#include "ocp_qp_res.h"
 #include "ocp_qp_hsde.h"
 #include "ocp_qp_hsde_common.h"
 #include "ocp_qp_hsde_kkt.h"

@@ -22,6 +22,7 @@ _C_FLOAT = re.compile(r"^-?[0-9]+(\.[0-9]*)?(e[-+]?[0-9]+)?$")
 # Runtime files compiled into the solver's translation unit, in dependency order.
 RUNTIME_SOURCES = (
     "ocp_qp.c",
+    "ocp_qp_res.c",
     "ocp_qp_kkt.c",
     "ocp_qp_hsde_kkt.c",
     "ocp_qp_hsde_setup.c",

@@ -5,6 +5,7 @@
  * QP part tests/test_ocp_qp.py compares with this list).
  */
 #include "ocp_qp.c"
+#include "ocp_qp_res.c"
 #include "ocp_qp_kkt.c"
 #include "ocp_qp_hsde_kkt.c"
 #include "ocp_qp_hsde_setup.c"
