@@ -8,6 +8,7 @@
 
 #include "monitor.h"
 #include "ocp_qp.h"
+#include "ocp_qp_res.h"
 
 /* KKT residuals of the NLP at the linearisation point with the multipliers in s->mult: exactly those
  * of the QP of this linearisation at a zero step (its gradient is the NLP's, its constraints are the

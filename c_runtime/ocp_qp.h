@@ -33,18 +33,6 @@ HM_FUNC int ocp_qp_check(const hm_ocp_qp *qp);
 /* 1 if the bound or row right-hand side takes part in the problem. */
 HM_FUNC int ocp_qp_bound_present(hm_real bound);
 
-/* Residuals of the KKT conditions of (qp, sol) in the conventions above (ocp_qp_types.h:
- * ocp_qp_res). */
-HM_FUNC void ocp_qp_res_compute(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, hm_ocp_qp_res *res);
-
-/* The same at the zero step (u = 0, x_n = 0 for n >= 1, x_0 = qp->x0: the linearisation point of an
- * SQP), with sol's slacks s and multipliers; sol's u and x are not read. What ocp_qp_res_compute
- * gives for that point, without its products with zeros. */
-HM_FUNC void ocp_qp_res_at_zero_step(const hm_ocp_qp *qp, const hm_ocp_qp_sol *sol, hm_ocp_qp_res *res);
-
-/* The worst of the residuals, the measure by which a polished solution must improve. */
-HM_FUNC hm_real ocp_qp_res_worst(const hm_ocp_qp_res *res);
-
 /* sol := the certificate of the crossing bounds lb > ub of component bad (stage * (HM_NU + HM_NX) +
  * component of (u, x)): lam_lb = lam_ub = 1 / (lb - ub), everything else zero, x_0 = qp->x0. */
 HM_FUNC void ocp_qp_sol_box_certificate(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, int bad);

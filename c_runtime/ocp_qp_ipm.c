@@ -25,6 +25,7 @@
  * from it only in rho, linearly, which is what lets pass D run on stage vectors alone.
  */
 #include "ocp_qp.h"
+#include "ocp_qp_res.h"
 #include "ocp_qp_hsde.h"
 #include "ocp_qp_ipm.h"
 #include "ocp_qp_ipm_cert.h"

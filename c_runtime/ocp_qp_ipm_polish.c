@@ -5,6 +5,7 @@
  * if it improves the worst KKT residual. Runs at the end of a solve, on the solve's memory.
  */
 #include "ocp_qp.h"
+#include "ocp_qp_res.h"
 #include "ocp_qp_kkt.h"
 #include "ocp_qp_ipm_common.h"
 #include "ocp_qp_ipm_polish.h"

@@ -24,7 +24,11 @@ _C_FLOAT = re.compile(r"^-?[0-9]+(\.[0-9]*)?(e[-+]?[0-9]+)?$")
 # Runtime files compiled into the solver's translation unit, in dependency order.
 RUNTIME_SOURCES = (
     "ocp_qp.c",
+    "ocp_qp_res.c",
     "ocp_qp_kkt.c",
+    "ocp_qp_hsde_kkt.c",
+    "ocp_qp_hsde_setup.c",
+    "ocp_qp_hsde_res.c",
     "ocp_qp_hsde.c",
     "ocp_qp_ipm_setup.c",
     "ocp_qp_ipm_lanes.c",

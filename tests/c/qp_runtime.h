@@ -5,7 +5,11 @@
  * QP part tests/test_ocp_qp.py compares with this list).
  */
 #include "ocp_qp.c"
+#include "ocp_qp_res.c"
 #include "ocp_qp_kkt.c"
+#include "ocp_qp_hsde_kkt.c"
+#include "ocp_qp_hsde_setup.c"
+#include "ocp_qp_hsde_res.c"
 #include "ocp_qp_hsde.c"
 #include "ocp_qp_ipm_setup.c"
 #include "ocp_qp_ipm_lanes.c"
