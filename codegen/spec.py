@@ -57,7 +57,7 @@ MAX_NAME_LEN = 31
 # Smallest QP tolerance a single-precision solver reaches reliably: measured on replays in crowds of
 # 10 and 30 humans, QPs solved to 1e-7 fail at the rounding floor (a third to three quarters of
 # them), to 3e-7 and above they do not (docs/firmware.md). The RTI line search solves its QPs to
-# 0.1 * qp_tol (ocp_nlp_sqp.c), so with it qp_tol must be ten times larger.
+# 0.1 * qp_tol (ocp_nlp_step.c), so with it qp_tol must be ten times larger.
 FLOAT_MIN_QP_TOL = 1e-6
 
 
