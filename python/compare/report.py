@@ -51,6 +51,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..bindings import load
 from ..codegen.reference_nlp import ReferenceNlp
 from ..codegen.spec import Spec, load_spec, resolve_spec
 from .peers.acados_client import (
@@ -314,15 +315,13 @@ def _run_ours(spec: Spec, solver_dir: str | Path | None, out: Path, replay: Repl
               params: dict[str, Any] | None = None) -> ReplayRun:
     """The replay through the generated solver (generated when no folder is given), with the
     replay's problem parameters and then ``params`` on top."""
-    import humanmpc  # the package itself; imported here so that compare.py loads without a built solver
-
     if solver_dir is None:
         solver_dir = out / "solvers" / f"{spec.name}_{spec.humans.max}"
         if not (solver_dir / "manifest.json").is_file() or params is None:
             from ..codegen.generate import generate
 
             solver_dir = generate(spec, solver_dir, force=True, log=lambda _m: None)
-    solver = humanmpc.load(solver_dir)
+    solver = load(solver_dir)
     say(f"[compare]   humanmpc{'' if not params else ' with ' + str(params)} ({solver_dir})")
     solver.reset()
     solver.set_params(**replay.params)

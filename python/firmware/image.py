@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..bindings import load
 from ..codegen import __version__
 from ..codegen.build import read_manifest
 from ..codegen.render import make_environment
@@ -475,12 +476,10 @@ def run_firmware(solver_dir: str | Path, cpu: str, replay: Replay | None = None,
                  n_humans: int | None = None, cold: bool = False, timeout: float = 600.0,
                  log: Callable[[str], None] | None = None) -> tuple[FirmwareRun, Agreement, Path]:
     """Record (or take) a replay, build and run it on cpu, compare with the host; (run, agreement, elf)."""
-    import humanmpc
-
     say = log or print_progress
     d = Path(solver_dir).resolve()
     require_tools()
-    host = humanmpc.load(d)
+    host = load(d)
     if replay is None:
         say(f"[humanmpc] recording {steps} steps with the host solver (seed {seed})")
         replay = record_replay(host, steps=steps, seed=seed, n_humans=n_humans)

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..bindings import load
 from ..codegen.spec import Spec, resolve_spec
 from .image import (
     build_firmware,
@@ -49,8 +50,6 @@ def footprint_report(base: Spec, humans: Sequence[int], cpus: Sequence[str], pre
                      steps: int, out_dir: Path, seed: int = 0,
                      log: Callable[[str], None] | None = None) -> list[ReportRow]:
     """Generate one package per (N_h, precision), build both programs per CPU, run the replay."""
-    import humanmpc
-
     from ..codegen.build import build
     from ..codegen.generate import generate
 
@@ -67,7 +66,7 @@ def footprint_report(base: Spec, humans: Sequence[int], cpus: Sequence[str], pre
             spec = resolve_spec(data, "report spec")
             d = generate(spec, out_dir / spec.name, force=True, log=quiet)
             build(d, log=quiet)
-            host = humanmpc.load(d)
+            host = load(d)
             if replay is None:  # one replay per N_h, recorded with the first precision's host solver
                 replay = record_replay(host, steps=steps, seed=seed)
             fw = write_firmware(d, replay)
