@@ -41,6 +41,19 @@ def _stage_package(root: Path) -> Path:
     return pkg
 
 
+def _checkout_modules() -> set[str]:
+    """humanmpc's modules and subpackages as the checkout holds them (what a wheel must carry)."""
+    names = set()
+    for root, prefix in ((REPO_ROOT / "python", "humanmpc"), (REPO_ROOT / "codegen", "humanmpc.codegen")):
+        for f in root.rglob("*.py"):
+            parts = list(f.relative_to(root).with_suffix("").parts)
+            if parts[-1] == "__init__":
+                parts = parts[:-1]
+            if parts:
+                names.add(".".join([prefix, *parts]))
+    return names | {"humanmpc.codegen", "humanmpc.codegen.templates", "humanmpc.codegen.c_runtime"}
+
+
 def _lint_imports(stage: Path) -> subprocess.CompletedProcess[str]:
     exe = Path(sys.executable).parent / "lint-imports"
     if not exe.is_file():
@@ -79,9 +92,16 @@ def test_a_reverse_import_breaks_its_contract(tmp_path: Path, module: str, line:
 
 @pytest.mark.slow
 def test_the_wheel_installed_in_a_fresh_venv_generates_builds_loads_and_steps_a_solver(tmp_path: Path) -> None:
+    # from a copy of what the wheel is made of: setuptools leaves build/ in the source folder, and a
+    # stale build/lib would carry modules the checkout no longer has
+    src = tmp_path / "src"
+    for part in ("python", "codegen", "templates", "c_runtime"):
+        shutil.copytree(REPO_ROOT / part, src / part, ignore=shutil.ignore_patterns("__pycache__"))
+    for part in ("pyproject.toml", "README.md"):
+        shutil.copy2(REPO_ROOT / part, src / part)
     wheel_dir = tmp_path / "wheel"
     build = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q",
-                            "-w", str(wheel_dir), str(REPO_ROOT)], cwd=tmp_path, env=_clean_env(),
+                            "-w", str(wheel_dir), str(src)], cwd=tmp_path, env=_clean_env(),
                            capture_output=True, text=True, timeout=600, check=False)
     assert build.returncode == 0, build.stderr[-3000:]
     wheels = list(wheel_dir.glob("humanmpc-*.whl"))
@@ -101,6 +121,20 @@ def test_the_wheel_installed_in_a_fresh_venv_generates_builds_loads_and_steps_a_
         proc = subprocess.run([str(gen), *cmd], cwd=work, env=_clean_env(), capture_output=True, text=True,
                               timeout=600, check=False)
         assert proc.returncode == 0, proc.stderr[-3000:]
+    # every module of the checkout is in the wheel and imports (acados_peer runs only in acados' venv)
+    walk = ("import importlib, pkgutil, humanmpc\n"
+            "names = sorted(m.name for m in pkgutil.walk_packages(humanmpc.__path__, 'humanmpc.'))\n"
+            "for n in names:\n"
+            "    if not n.endswith(('acados_peer', '__main__')):\n"
+            "        importlib.import_module(n)\n"
+            "print(' '.join(names))\n")
+    proc = subprocess.run([str(python), "-c", walk], cwd=work, env=_clean_env(), capture_output=True, text=True,
+                          timeout=600, check=False)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert set(proc.stdout.split()) == _checkout_modules()
+    help_proc = subprocess.run([str(gen), "--help"], cwd=work, env=_clean_env(), capture_output=True, text=True,
+                               timeout=120, check=False)
+    assert help_proc.returncode == 0 and "firmware-report" in help_proc.stdout
     script = (
         "import numpy as np, humanmpc, pathlib\n"
         "assert 'site-packages' in humanmpc.__file__, humanmpc.__file__\n"
