@@ -229,7 +229,6 @@ PARAMS: tuple[Param, ...] = (
           spec_choices=("gauss_newton", "exact")),
 )
 
-BY_NAME: Mapping[str, Param] = {p.name: p for p in PARAMS}
 BY_KEY: Mapping[str, Param] = {p.key: p for p in PARAMS}
 PROBLEM_PARAMS: tuple[Param, ...] = tuple(p for p in PARAMS if p.problem)
 
@@ -242,23 +241,4 @@ def spec_params(spec: Any) -> dict[str, Any]:
         for part in p.key.split("."):
             value = getattr(value, part)
         out[p.name] = p.spec_value(value)
-    return out
-
-
-def check_params(values: Mapping[str, Any]) -> dict[str, Any]:
-    """Every value checked against its row (unknown names refused); all problems reported at once."""
-    problems: list[str] = []
-    out: dict[str, Any] = {}
-    for key, value in values.items():
-        p = BY_NAME.get(key)
-        if p is None:
-            problems.append(f"{key}: unknown parameter; parameters are {', '.join(BY_NAME)}")
-            continue
-        v, why = p.check(value)
-        if why is not None:
-            problems.append(f"{key}: {why}: must be {p.rule}")
-        else:
-            out[key] = v
-    if problems:
-        raise ValueError("invalid runtime parameter(s):\n  - " + "\n  - ".join(problems))
     return out
