@@ -52,6 +52,15 @@ C_KEYWORDS = frozenset(
     ]
 )
 RESERVED_NAMES = frozenset({"hm", "casadi", "humanmpc", "main", "errno", "assert"})
+# The package writes <name>.h beside the sources that include the system's headers: a name that is
+# a standard C or common POSIX header's would shadow it (a spec named "time" silently replaced
+# <time.h>, and with it the deadline monitor's clock).
+SYSTEM_HEADER_NAMES = frozenset({
+    "assert", "complex", "ctype", "errno", "fenv", "float", "inttypes", "iso646", "limits", "locale", "math",
+    "setjmp", "signal", "stdalign", "stdarg", "stdatomic", "stdbool", "stddef", "stdint", "stdio", "stdlib",
+    "stdnoreturn", "string", "tgmath", "threads", "time", "uchar", "wchar", "wctype", "unistd", "pthread",
+    "sched", "fcntl", "strings", "alloca", "malloc", "features", "endian", "cffi", "casadi",
+})
 IDENT_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 MAX_NAME_LEN = 31
 # Smallest QP tolerance a single-precision solver reaches reliably: measured on replays in crowds of
@@ -157,6 +166,9 @@ class Rule:
             return None, [f"{path}: {value!r} is too long: at most {MAX_NAME_LEN} characters"]
         if value in C_KEYWORDS or value.lower() in RESERVED_NAMES:
             return None, [f"{path}: {value!r} is reserved (a C keyword or a runtime prefix): choose another name"]
+        if value.lower() in SYSTEM_HEADER_NAMES:
+            return None, [f"{path}: {value!r} is reserved: the package's {value}.h would shadow the system header "
+                          f"<{value.lower()}.h>: choose another name"]
         return value, []
 
 
