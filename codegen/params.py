@@ -133,7 +133,11 @@ class Param:
             entry = i if self.kind == "vector" else None
             if isinstance(v, (bool, np.bool_, str, bytes)) or not isinstance(v, (int, float, np.integer, np.floating)):
                 return None, f"{v!r} has the wrong type: not a number", entry
-            if not math.isfinite(float(v)):
+            try:
+                x = float(v)
+            except OverflowError:
+                return None, f"{v!r} is too large", entry
+            if not math.isfinite(x):
                 return None, f"{v!r} is not finite", entry
             nums.append(float(v))
         if self.kind == "interval":

@@ -72,7 +72,7 @@ def c_float(x: float) -> str:
 
 
 def c_identifier(name: str) -> str:
-    if not IDENT_RE.match(name):
+    if not IDENT_RE.fullmatch(name):
         raise ValueError(f"{name!r} is not a C identifier")
     return name
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import hashlib
+import io
 import json
 import math
 import re
@@ -61,7 +62,8 @@ SYSTEM_HEADER_NAMES = frozenset({
     "stdnoreturn", "string", "tgmath", "threads", "time", "uchar", "wchar", "wctype", "unistd", "pthread",
     "sched", "fcntl", "strings", "alloca", "malloc", "features", "endian", "cffi", "casadi",
 })
-IDENT_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+# Matched with fullmatch: "$" alone also matches before a trailing newline.
+IDENT_RE = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 MAX_NAME_LEN = 31
 # Smallest QP tolerance a single-precision solver reaches reliably: measured on replays in crowds of
 # 10 and 30 humans, QPs solved to 1e-7 fail at the rounding floor (a third to three quarters of
@@ -101,7 +103,10 @@ class Rule:
     def _check_number(self, path: str, value: Any) -> tuple[Any, list[str]]:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             return None, [f"{path}: {value!r} has the wrong type: must be a number"]
-        x = float(value)
+        try:
+            x = float(value)
+        except OverflowError:
+            return None, [f"{path}: {value!r} is too large: must be a finite number"]
         if not math.isfinite(x):
             return None, [f"{path}: {value!r} is not finite: must be a finite number"]
         return x, self._range_problems(path, x)
@@ -157,7 +162,7 @@ class Rule:
     def _check_name(self, path: str, value: Any) -> tuple[Any, list[str]]:
         if not isinstance(value, str):
             return None, [f"{path}: {value!r} has the wrong type: must be a string (a C identifier)"]
-        if not IDENT_RE.match(value):
+        if not IDENT_RE.fullmatch(value):
             return None, [
                 f"{path}: {value!r} is not a C identifier: use a letter followed by letters, "
                 "digits or underscores"
@@ -394,7 +399,16 @@ def resolve_spec(data: Any, source: str = "spec") -> Spec:
 
 
 class _UniqueKeyLoader(yaml.SafeLoader):
-    """yaml.SafeLoader that refuses duplicate keys instead of silently keeping the last one."""
+    """yaml.SafeLoader that refuses duplicate keys instead of silently keeping the last one, and
+    refuses aliases: a spec needs none, and nested aliases expand exponentially (a 510-byte
+    document to gigabytes)."""
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        if self.check_event(yaml.AliasEvent):
+            mark = self.peek_event().start_mark
+            raise SpecError([f"line {mark.line + 1}: YAML aliases (*name) are not allowed in a spec: "
+                             "write the value out"])
+        return super().compose_node(parent, index)
 
 
 def _construct_unique_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False) -> Any:
@@ -421,15 +435,28 @@ _UniqueKeyLoader.add_constructor(
 )
 
 
-def parse_spec_text(text: str, source: str = "spec") -> Spec:
-    """Parse YAML text (safe loader, duplicate keys refused) and resolve it."""
+# A spec is a few dozen lines: anything much larger is a mistake (or an attack on the loader).
+MAX_SPEC_BYTES = 64 * 1024
+
+
+def _parse_yaml(text: str, source: str) -> Any:
+    """The YAML document in text: safe loader, duplicate keys and aliases refused, size bounded,
+    errors naming the source."""
+    if len(text.encode("utf-8", errors="replace")) > MAX_SPEC_BYTES:
+        raise SpecError([f"the spec is {len(text):,} characters long: at most {MAX_SPEC_BYTES:,} bytes"], source)
+    stream = io.StringIO(text)
+    stream.name = source  # PyYAML names this in its error marks
     try:
-        data = yaml.load(text, Loader=_UniqueKeyLoader)
+        return yaml.load(stream, Loader=_UniqueKeyLoader)
     except SpecError as err:
         raise SpecError(err.problems, source) from None
     except yaml.YAMLError as err:
         raise SpecError([f"not valid YAML: {err}"], source) from None
-    return resolve_spec(data, source)
+
+
+def parse_spec_text(text: str, source: str = "spec") -> Spec:
+    """Parse YAML text (safe loader, duplicate keys and aliases refused) and resolve it."""
+    return resolve_spec(_parse_yaml(text, source), source)
 
 
 def load_spec(path: str | Path | None) -> Spec:
@@ -438,10 +465,18 @@ def load_spec(path: str | Path | None) -> Spec:
         return Spec()
     p = Path(path)
     try:
+        if p.stat().st_size > MAX_SPEC_BYTES:
+            raise SpecError([f"{p} is {p.stat().st_size:,} bytes: a spec is at most {MAX_SPEC_BYTES:,}"], str(p))
         text = p.read_text(encoding="utf-8")
     except OSError as err:
         raise SpecError([f"cannot read {p}: {err.strerror}"], str(p)) from None
-    return parse_spec_text(text, str(p))
+    except UnicodeDecodeError as err:
+        raise SpecError([f"{p} is not UTF-8 text: {err.reason} at byte {err.start}"], str(p)) from None
+    data = _parse_yaml(text, str(p))
+    if data is None:
+        raise SpecError([f"{p} holds no keys: write at least one (e.g. name: mysolver), or give no file to use "
+                         "the built-in spec"], str(p))
+    return resolve_spec(data, str(p))
 
 
 def describe_schema() -> list[tuple[str, str, Any]]:

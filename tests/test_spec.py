@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import pytest
@@ -11,7 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from humanmpc import cli
-from humanmpc.codegen.spec import Spec, SpecError, describe_schema, parse_spec_text, resolve_spec
+from humanmpc.codegen.render import c_identifier
+from humanmpc.codegen.spec import Spec, SpecError, describe_schema, load_spec, parse_spec_text, resolve_spec
 
 
 def test_defaults_are_the_papers_values() -> None:
@@ -163,3 +165,46 @@ def test_valid_specs_resolve_to_what_was_written(n: int, nh: int, t: float, w: l
     assert (s.horizon.N, s.horizon.T, s.humans.max) == (n, t, nh)
     assert s.weights.goal == tuple(w)
     assert s.n_rows == nh + 1
+
+
+def test_yaml_aliases_are_refused_before_they_expand(tmp_path: Path) -> None:
+    """Nested aliases expand exponentially (a 510-byte document to gigabytes): a spec may use none."""
+    lines = ["a: &a [1, 1, 1, 1, 1, 1, 1, 1, 1]"]
+    lines += [f"{c}: &{c} [{', '.join([f'*{p}'] * 9)}]" for p, c in zip("abcdefgh", "bcdefghi", strict=True)]
+    bomb = tmp_path / "bomb.yaml"
+    bomb.write_text("\n".join(lines) + "\n")
+    assert len(bomb.read_bytes()) < 600
+    with pytest.raises(SpecError, match="line 2: YAML aliases"):
+        load_spec(bomb)
+    with pytest.raises(SpecError, match="at most"):
+        parse_spec_text("name: x\n" + "# padding\n" * 10000)
+
+
+def test_an_empty_spec_file_is_an_error_not_the_default_spec(tmp_path: Path) -> None:
+    for text in ("", "\n", "# only a comment\n"):
+        f = tmp_path / "empty.yaml"
+        f.write_text(text)
+        with pytest.raises(SpecError, match="holds no keys"):
+            load_spec(f)
+
+
+def test_a_name_with_a_trailing_newline_is_not_a_c_identifier() -> None:
+    with pytest.raises(SpecError, match="not a C identifier"):
+        parse_spec_text('name: "paper\\n"')
+    with pytest.raises(ValueError, match="not a C identifier"):
+        c_identifier("paper\n")
+
+
+def test_a_number_too_large_for_a_double_is_an_error_not_a_traceback(tmp_path: Path) -> None:
+    for text, key in ((f"humans: {{d_h: {10**400}}}", "humans.d_h"), (f"horizon: {{T: {10**400}}}", "horizon.T"),
+                      (f"weights: {{goal: [1, {10**400}, 0, 1]}}", "weights.goal[1]")):
+        with pytest.raises(SpecError, match=re.escape(key) + r".* is too large"):
+            parse_spec_text(text)
+
+
+def test_a_yaml_syntax_error_names_the_file(tmp_path: Path) -> None:
+    f = tmp_path / "tabs.yaml"
+    f.write_text("horizon:\n\tN: 50\n")
+    with pytest.raises(SpecError) as info:
+        load_spec(f)
+    assert 'in "' + str(f) + '", line 2' in str(info.value)
