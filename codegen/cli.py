@@ -99,6 +99,25 @@ def add_generator_commands(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_cmd_keys)
 
 
+def non_negative_int(text: str) -> int:
+    """argparse type: a seed or an index (argparse names the option in its message)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{value} is negative: it must be an integer >= 0")
+    return value
+
+
+def positive_int(text: str) -> int:
+    """argparse type: a count of seeds, steps or workers."""
+    value = non_negative_int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value} must be an integer >= 1")
+    return value
+
+
 # What the generator's commands raise for a user's mistake or a failed tool: reported in one line.
 GENERATOR_ERRORS: tuple[type[Exception], ...] = (GenerateError, BuildError, FileNotFoundError)
 

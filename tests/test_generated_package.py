@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -90,6 +91,12 @@ def test_generated_folder_builds_on_its_own_with_cmake(paper_dir: Path, tmp_path
     build_dir = tmp_path / "cmake-build"
     run([cmake, "-S", str(paper_dir), "-B", str(build_dir), "-DCMAKE_C_FLAGS=-Werror"])
     run([cmake, "--build", str(build_dir)])
+    # the package's build/ belongs to its Makefile (make clean deletes it): CMake refuses it
+    shadow = tmp_path / "shadow"
+    shutil.copytree(paper_dir, shadow, ignore=shutil.ignore_patterns("build"))
+    proc = subprocess.run([cmake, "-S", str(shadow), "-B", str(shadow / "build")], capture_output=True, text=True,
+                          check=False)
+    assert proc.returncode != 0 and "build with -B build-cmake" in proc.stdout + proc.stderr
     assert (build_dir / "libpaper.a").exists() and (build_dir / "libpaper.so").exists()
 
 

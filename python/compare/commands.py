@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..codegen.cli import positive_int
 from ..codegen.spec import SpecError, load_spec
 from .report import add_compare_arguments
 
@@ -36,8 +37,8 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:
                        "closed loops (humans at constant velocity, one obstacle near the path).")
     p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
     p.add_argument("--humans", default="5,10,20,30", help="crowd sizes N_h (default: 5,10,20,30)")
-    p.add_argument("--seeds", type=int, default=3, help="closed loops per crowd size (default: 3)")
-    p.add_argument("--steps", type=int, default=300, help="RTI steps per closed loop (default: 300)")
+    p.add_argument("--seeds", type=positive_int, default=3, help="closed loops per crowd size (default: 3)")
+    p.add_argument("--steps", type=positive_int, default=300, help="RTI steps per closed loop (default: 300)")
     p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
     add_compare_arguments(p)
     p.set_defaults(func=_cmd_bench)

@@ -52,6 +52,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..bindings import load
+from ..codegen.cli import non_negative_int
 from ..codegen.reference_nlp import ReferenceNlp
 from ..codegen.spec import Spec, load_spec, resolve_spec
 from .peers.acados_client import (
@@ -434,7 +435,7 @@ def add_compare_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument("--compare-replays", nargs="+", type=Path, metavar="REPLAY.npz",
                    help="recorded replays, one per spec (default: synthetic random crowds)")
     g.add_argument("--compare-steps", type=int, default=100, help="steps of each synthetic replay (default 100)")
-    g.add_argument("--compare-seed", type=int, default=0, help="seed of the synthetic replays (default 0)")
+    g.add_argument("--compare-seed", type=non_negative_int, default=0, help="seed of the synthetic replays (default 0)")
     g.add_argument("--compare-out", type=Path, default=Path("out/compare"),
                    help="output folder (default out/compare)")
     g.add_argument("--compare-skip", nargs="+", default=[], choices=list(SOLVERS), metavar="SOLVER",

@@ -18,6 +18,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..codegen.cli import non_negative_int, positive_int
 from ..planners.registry import planner_names
 from ..sim.scenarios import SCENARIOS
 
@@ -27,9 +28,14 @@ def _simulate(args: argparse.Namespace) -> int:
     from ..sim.scenarios import make_scenario
     from .episode import run_episode
     from .metrics import compute_metrics
-    from .plots import animate_episode, plot_episodes
+    from .plots import animate_episode, animation_path, figure_path, plot_episodes
 
     try:
+        # the output names first: a typo must not cost the episode
+        if args.plot:
+            figure_path(args.plot)
+        if args.animate:
+            animation_path(args.animate)
         scenario = make_scenario(args.scenario, args.seed)
         planner = make_planner(args.planner)
     except ValueError as err:
@@ -77,7 +83,7 @@ def add_simulate_parser(subparsers: argparse._SubParsersAction) -> argparse.Argu
     p = subparsers.add_parser("simulate", help="run one closed-loop episode and print its metrics")
     p.add_argument("--scenario", required=True, help=f"one of: {', '.join(sorted(SCENARIOS))}")
     p.add_argument("--planner", required=True, help=f"a registered planner (now: {', '.join(planner_names())})")
-    p.add_argument("--seed", type=int, default=0, help="scenario seed (default 0)")
+    p.add_argument("--seed", type=non_negative_int, default=0, help="scenario seed (default 0)")
     p.add_argument("--plot", type=Path, help="write the paths figure to this file (.png/.svg/.pdf)")
     p.add_argument("--animate", type=Path, help="write an animated GIF of the episode to this file")
     p.set_defaults(func=_simulate)
@@ -89,9 +95,9 @@ def add_evaluate_parser(subparsers: argparse._SubParsersAction) -> argparse.Argu
     p = subparsers.add_parser("evaluate", help="run scenarios x planners x seeds and tabulate the metrics")
     p.add_argument("--scenarios", nargs="+", help="default: all of " + ", ".join(sorted(SCENARIOS)))
     p.add_argument("--planners", nargs="+", help="default: every registered planner")
-    p.add_argument("--seeds", type=int, default=10, help="number of seeds per scenario (default 10)")
-    p.add_argument("--first-seed", type=int, default=0, help="first seed (default 0)")
-    p.add_argument("--workers", type=int, default=2, help="parallel worker processes (default 2)")
+    p.add_argument("--seeds", type=positive_int, default=10, help="number of seeds per scenario (default 10)")
+    p.add_argument("--first-seed", type=non_negative_int, default=0, help="first seed (default 0)")
+    p.add_argument("--workers", type=positive_int, default=2, help="parallel worker processes (default 2)")
     p.add_argument("--out", type=Path, default=Path("out/evaluation"), help="output folder (default out/evaluation)")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -112,7 +118,7 @@ def add_demo_parser(subparsers: argparse._SubParsersAction) -> argparse.Argument
                               description="Generate the default solver, run the crossing-group scenario with the MPC "
                               "and the DWB baseline, print their metrics side by side and the timing summary, "
                               "and write the figure.")
-    p.add_argument("--seed", type=int, default=0, help="scenario seed (default 0)")
+    p.add_argument("--seed", type=non_negative_int, default=0, help="scenario seed (default 0)")
     p.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
     p.set_defaults(func=_demo)
     return p

@@ -22,6 +22,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon as PolygonPatch
 
@@ -66,11 +67,30 @@ def draw_humans(ax: Axes, log: EpisodeLog, every: int = 5) -> None:
         ax.add_patch(CirclePatch(log.humans[0, i], log.robot.human_radius, fill=False, ec=colour, lw=1.0, zorder=3))
 
 
+def figure_path(path: str | Path) -> Path:
+    """The path of a figure whose format matplotlib writes (by its extension); ValueError otherwise.
+    Checked before an episode runs, so that a typo does not cost the run."""
+    out = Path(path)
+    formats = sorted(Figure().canvas.get_supported_filetypes())
+    if out.suffix.lower().lstrip(".") not in formats:
+        raise ValueError(f"{out.name}: {out.suffix or 'no extension'} is not a figure format; use one of "
+                         f"{', '.join('.' + f for f in formats)}")
+    return out
+
+
+def animation_path(path: str | Path) -> Path:
+    """The path of a GIF; ValueError otherwise."""
+    out = Path(path)
+    if out.suffix.lower() != ".gif":
+        raise ValueError(f"animate_episode writes a GIF; give a .gif file name, got {out.name}")
+    return out
+
+
 def plot_episodes(logs: Sequence[EpisodeLog], path: str | Path, title: str | None = None) -> Path:
     """Write the paths figure (PNG, SVG or PDF by extension) and return its path."""
     if not logs:
         raise ValueError("plot_episodes needs at least one episode log")
-    out = Path(path)
+    out = figure_path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig = plt.figure(figsize=(7.5, 10.0))
     grid = fig.add_gridspec(3, 1, height_ratios=[3.2, 1, 1])
@@ -108,9 +128,7 @@ def plot_episodes(logs: Sequence[EpisodeLog], path: str | Path, title: str | Non
 
 def animate_episode(log: EpisodeLog, path: str | Path, fps: int = 10, stride: int = 2) -> Path:
     """Write an animated GIF of the episode (every ``stride``-th step)."""
-    out = Path(path)
-    if out.suffix.lower() != ".gif":
-        raise ValueError(f"animate_episode writes a GIF; give a .gif file name, got {out.name}")
+    out = animation_path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(figsize=(6, 6))
     draw_world(ax, log.world)
