@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .codegen.build import build, is_stale
 from .codegen.params import Param
+from .codegen.spec import IDENT_RE
 from .solver import Solver
 
 FloatArray = NDArray[np.float64]
@@ -108,15 +109,28 @@ def load(solver_dir: str | Path, *, build_if_needed: bool = True) -> Solver:
     manifest_path = d / "manifest.json"
     if not manifest_path.is_file():
         raise LoadError(f"{d} is not a generated humanmpc solver (no manifest.json); run `humanmpc-gen generate`")
-    manifest = json.loads(manifest_path.read_text())
-    name = manifest["name"]
+    try:
+        manifest = json.loads(manifest_path.read_text())
+        name = manifest["name"]
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        raise LoadError(f"{manifest_path} is not a humanmpc manifest ({err!r}); regenerate the package") from None
+    if not isinstance(name, str) or not IDENT_RE.fullmatch(name):
+        raise LoadError(f"{d}: the manifest's name {name!r} is not a C identifier; regenerate the package")
     if is_stale(d):
         if not build_if_needed:
             raise LoadError(f"{d}: the library is missing or older than its sources; run `humanmpc-gen build {d}`")
         build(d)
+    # the library is the package's own: a manifest may not point anywhere else
+    lib_path = (d / str(manifest["library"])).resolve()
+    if not lib_path.is_relative_to(d) or lib_path.suffix != ".so":
+        raise LoadError(f"{d}: the manifest's library {manifest['library']!r} is not a .so inside the package")
     ffi = cffi.FFI()
-    ffi.cdef((d / f"{name}_cffi.h").read_text())
-    lib = ffi.dlopen(str(d / manifest["library"]))
+    try:
+        ffi.cdef((d / f"{name}_cffi.h").read_text())
+    except (OSError, cffi.CDefError) as err:
+        raise LoadError(f"{d}: {name}_cffi.h cannot be read as the package's declarations ({err}); "
+                        "regenerate the package") from None
+    lib = ffi.dlopen(str(lib_path))
     got_hash = ffi.string(getattr(lib, f"{name}_spec_hash")()).decode()
     if got_hash != manifest["spec_hash"]:
         raise LoadError(f"{d}: the library was built from spec {got_hash[:12]}, the folder holds "
@@ -126,6 +140,13 @@ def load(solver_dir: str | Path, *, build_if_needed: bool = True) -> Solver:
     m = manifest["dims"]
     if list(sizes) != [m["nx"], m["nu"], m["N"], m["nh"], m["ng"]]:
         raise LoadError(f"{d}: library sizes {list(sizes)} do not match the manifest")
+    # the declarations cffi writes through must be the compiled structs, byte for byte in size
+    compiled = ffi.new("size_t[3]")
+    getattr(lib, f"{name}_struct_sizes")(compiled + 0, compiled + 1, compiled + 2)
+    declared = [ffi.sizeof(f"{name}_{s}") for s in ("params", "input", "output")]
+    if list(compiled) != declared:
+        raise LoadError(f"{d}: {name}_cffi.h declares params/input/output of {declared} bytes, the library "
+                        f"was compiled with {list(compiled)}: regenerate and rebuild the package")
     m = manifest["dims"]
     dims_obj = Dims(nx=m["nx"], nu=m["nu"], N=m["N"], nh=m["nh"], ng=m["ng"], dt=m["dt"], T=m["T"])
     model = ModelFunctions(

@@ -11,6 +11,7 @@ the bench's closed loop (where the solver's data have pushed Python's out of the
 from __future__ import annotations
 
 import math
+import threading
 from typing import Any
 
 import numpy as np
@@ -98,6 +99,9 @@ class Solver:
         self._params_rule = fn("params_rule")
         self._params_staged = ffi.new(f"{name}_params *")
         self.log: StepLog | None = None
+        # One solver, one step at a time: cffi releases the GIL in C, and two threads stepping the
+        # same solver memory crashed. Callers from several threads are serialised.
+        self._lock = threading.Lock()
 
     def start_log(self, capacity: int = 10000) -> StepLog:
         """Keep the newest `capacity` steps (status, stop reason, timings, closest human) in self.log."""
@@ -163,25 +167,28 @@ class Solver:
         humans_now: (k, 2) current positions, k <= N_h; humans_pred: (N+1, k, 2) predicted
         positions at the nodes; obstacle: (2,) closest obstacle point or None.
         """
-        self._load_inputs(x0, goal, humans_now, humans_pred, obstacle)
-        self._c_step(self._solver, self._in, self._out)
-        return self._result()
+        with self._lock:
+            self._load_inputs(x0, goal, humans_now, humans_pred, obstacle)
+            self._c_step(self._solver, self._in, self._out)
+            return self._result()
 
     def prepare(self, goal: ArrayLike, humans_now: ArrayLike | None = None, humans_pred: ArrayLike | None = None,
                 obstacle: ArrayLike | None = None, x0_guess: ArrayLike | None = None) -> None:
         """The preparation phase alone (before the measurement): x0_guess is used only on a cold start."""
-        guess = self._x0.copy() if x0_guess is None else x0_guess
-        self._load_inputs(guess, goal, humans_now, humans_pred, obstacle)
-        self._c_prepare(self._solver, self._in)
+        with self._lock:
+            guess = self._x0.copy() if x0_guess is None else x0_guess
+            self._load_inputs(guess, goal, humans_now, humans_pred, obstacle)
+            self._c_prepare(self._solver, self._in)
 
     def feedback(self, x0: ArrayLike) -> StepResult:
         """The feedback phase: insert the measured state into the prepared QP and solve it."""
         x0a = np.asarray(x0, dtype=np.float64)
         if x0a.shape != (4,):
             raise ValueError(f"x0 must have shape (4,) = [px, py, theta, v], got {x0a.shape}")
-        self._x0[...] = x0a
-        self._c_feedback(self._solver, self._in, self._out)
-        return self._result()
+        with self._lock:
+            self._x0[...] = x0a
+            self._c_feedback(self._solver, self._in, self._out)
+            return self._result()
 
     def solve(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None = None,
               humans_pred: ArrayLike | None = None, obstacle: ArrayLike | None = None, *,
@@ -191,13 +198,15 @@ class Solver:
             raise ValueError(f"max_iter must be >= 1, got {max_iter}")
         if not (math.isfinite(tol) and tol > 0):
             raise ValueError(f"tol must be a positive finite number, got {tol}")
-        self._load_inputs(x0, goal, humans_now, humans_pred, obstacle)
-        self._c_solve(self._solver, self._in, self._out, int(max_iter), float(tol))
-        return self._result()
+        with self._lock:
+            self._load_inputs(x0, goal, humans_now, humans_pred, obstacle)
+            self._c_solve(self._solver, self._in, self._out, int(max_iter), float(tol))
+            return self._result()
 
     def reset(self) -> None:
         """Forget the previous plan: the next step starts cold. Parameters are kept."""
-        self._c_reset(self._solver)
+        with self._lock:
+            self._c_reset(self._solver)
 
     # -- parameters ---------------------------------------------------------------------------
     @property
@@ -234,14 +243,15 @@ class Solver:
             raise ValueError("invalid runtime parameter(s), none changed:\n  - " + "\n  - ".join(problems))
         # The C check has the last word (the same table): a combination it refuses changes nothing.
         ffi = self._ffi
-        ffi.memmove(self._params_staged, self._params, ffi.sizeof(f"{self.name}_params"))
-        for key, v in staged:
-            setattr(self._params_staged, key, v)
-        broken = int(self._params_check(self._params_staged))
-        if broken:
-            rule = ffi.string(self._params_rule(broken)).decode()
-            raise ValueError(f"invalid runtime parameter(s), none changed: {rule}")
-        ffi.memmove(self._params, self._params_staged, ffi.sizeof(f"{self.name}_params"))
+        with self._lock:
+            ffi.memmove(self._params_staged, self._params, ffi.sizeof(f"{self.name}_params"))
+            for key, v in staged:
+                setattr(self._params_staged, key, v)
+            broken = int(self._params_check(self._params_staged))
+            if broken:
+                rule = ffi.string(self._params_rule(broken)).decode()
+                raise ValueError(f"invalid runtime parameter(s), none changed: {rule}")
+            ffi.memmove(self._params, self._params_staged, ffi.sizeof(f"{self.name}_params"))
 
     def status_message(self, status: int) -> str:
         return str(self._ffi.string(self._status_message(status)).decode())
