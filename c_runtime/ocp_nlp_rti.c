@@ -18,6 +18,25 @@
 #include "ocp_nlp_step.h"
 #include "ocp_qp.h"
 
+/* Byte-wise copy and comparison of the parameters (struct assignment need not copy padding bytes). */
+static void ocp_nlp_params_remember(hm_solver *s)
+{
+    const unsigned char *from = (const unsigned char *)&s->params;
+    unsigned char *to = (unsigned char *)&s->params_prepared;
+    size_t i;
+    for (i = 0; i < sizeof s->params; i++) to[i] = from[i];
+}
+
+static int ocp_nlp_params_changed(const hm_solver *s)
+{
+    const unsigned char *a = (const unsigned char *)&s->params;
+    const unsigned char *b = (const unsigned char *)&s->params_prepared;
+    unsigned diff = 0;
+    size_t i;
+    for (i = 0; i < sizeof s->params; i++) diff |= (unsigned)(a[i] ^ b[i]);
+    return diff != 0;
+}
+
 HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in)
 {
     const unsigned long long t0 = ocp_nlp_now(s);
@@ -31,6 +50,7 @@ HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in)
          * Gauss-Newton model misses the costate-weighted curvature of the dynamics, and its full steps
          * flip omega between its bounds from one step to the next. */
         ocp_nlp_linearize(s, in, s->warm && s->params.exact_hessian);
+        ocp_nlp_params_remember(s);
         s->prepared = 1;
     }
     s->time_prepare_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
@@ -72,7 +92,14 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
     out->sqp_iterations = 1;
     reason = ocp_nlp_check_before(s, in);
     if (reason == HM_STOP_NONE) {
-        if (!s->prepared) ocp_nlp_sqp_rti_prepare(s, in);
+        if (!s->prepared) {
+            ocp_nlp_sqp_rti_prepare(s, in);
+        } else if (ocp_nlp_params_changed(s)) {
+            /* the parameters changed since the preparation, whose QP holds the old bounds and
+             * weights: linearise again at the point it shifted to (not a second shift) */
+            ocp_nlp_linearize(s, in, s->warm && s->params.exact_hessian);
+            ocp_nlp_params_remember(s);
+        }
         t_feedback = ocp_nlp_now(s);
         if (!s->warm) ocp_qp_sol_set_zero(&s->mult);
         ocp_nlp_set_x0(s, in);

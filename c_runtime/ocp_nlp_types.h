@@ -43,4 +43,7 @@ typedef struct HM_NS(solver) {
     void *clock_ctx;
     unsigned long long t_start;      /* clock reading at the start of the step (deadline origin) */
     unsigned long long deadline_ns;
+    /* The parameters the current preparation used, byte for byte: a feedback under changed ones
+     * (new bounds, weights, ...) prepares again instead of solving a QP built with the old ones. */
+    HM_NS(params) params_prepared;
 } HM_NS(solver);
