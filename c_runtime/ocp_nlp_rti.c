@@ -37,7 +37,7 @@ static int ocp_nlp_params_changed(const hm_solver *s)
     return diff != 0;
 }
 
-HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in)
+static void ocp_nlp_rti_prepare(hm_solver *s, const hm_input *in)
 {
     const unsigned long long t0 = ocp_nlp_now(s);
     s->prepared = 0;
@@ -50,10 +50,17 @@ HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in)
          * Gauss-Newton model misses the costate-weighted curvature of the dynamics, and its full steps
          * flip omega between its bounds from one step to the next. */
         ocp_nlp_linearize(s, in, s->warm && s->params.exact_hessian);
-        ocp_nlp_params_remember(s);
         s->prepared = 1;
     }
     s->time_prepare_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
+}
+
+/* The preparation alone, before a separate feedback: which may come under changed parameters, so
+ * the ones it used are remembered (a whole step needs no copy: nothing runs between its phases). */
+HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in)
+{
+    ocp_nlp_rti_prepare(s, in);
+    if (s->prepared) ocp_nlp_params_remember(s);
 }
 
 /* Deadline hook of the QP iterations. */
@@ -79,7 +86,9 @@ static void ocp_nlp_start_clock(hm_solver *s, unsigned long long t_start)
     s->deadline_ns = (unsigned long long)whole * 1000000ULL + frac_ns;
 }
 
-static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output *out, unsigned long long t_start)
+/* separate: a feedback after the caller's own preparation, whose parameters may have changed since */
+static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output *out, unsigned long long t_start,
+                                     int separate)
 {
     unsigned long long t_feedback;
     int qp_status, status, reason;
@@ -93,8 +102,8 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
     reason = ocp_nlp_check_before(s, in);
     if (reason == HM_STOP_NONE) {
         if (!s->prepared) {
-            ocp_nlp_sqp_rti_prepare(s, in);
-        } else if (ocp_nlp_params_changed(s)) {
+            ocp_nlp_rti_prepare(s, in);
+        } else if (separate && ocp_nlp_params_changed(s)) {
             /* the parameters changed since the preparation, whose QP holds the old bounds and
              * weights: linearise again at the point it shifted to (not a second shift) */
             ocp_nlp_linearize(s, in, s->warm && s->params.exact_hessian);
@@ -175,13 +184,13 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
 HM_FUNC int ocp_nlp_sqp_rti_feedback(hm_solver *s, const hm_input *in, hm_output *out)
 {
     if (!s->prepared) s->time_prepare_ms = HM_R(0.0);
-    return ocp_nlp_rti_feedback_from(s, in, out, ocp_nlp_now(s));
+    return ocp_nlp_rti_feedback_from(s, in, out, ocp_nlp_now(s), 1);
 }
 
 /* A whole real-time iteration: the deadline counts from the start of the preparation. */
 HM_FUNC int ocp_nlp_sqp_rti_step(hm_solver *s, const hm_input *in, hm_output *out)
 {
     const unsigned long long t0 = ocp_nlp_now(s);
-    ocp_nlp_sqp_rti_prepare(s, in);
-    return ocp_nlp_rti_feedback_from(s, in, out, t0);
+    ocp_nlp_rti_prepare(s, in);
+    return ocp_nlp_rti_feedback_from(s, in, out, t0, 0);
 }
