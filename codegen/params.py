@@ -118,15 +118,14 @@ class Param:
             i = int(value)
             ok = i in (0, 1) if self.kind == "flag" else self.valid is not None and self.valid.holds(i)
             return (i, None, None) if ok else (None, f"{value!r} is out of range", None)
+        what = "an interval [lower, upper]" if self.kind == "interval" else f"a list of {self.size} numbers"
         if self.size == 1:
             items = [value]
         elif isinstance(value, (list, tuple)) or (isinstance(value, np.ndarray) and value.ndim == 1):
             items = list(value)
         else:
-            what = "an interval [lower, upper]" if self.kind == "interval" else f"a list of {self.size} numbers"
             return None, f"{value!r} is not {what}", None
         if len(items) != self.size:
-            what = "an interval [lower, upper]" if self.kind == "interval" else f"a list of {self.size} numbers"
             return None, f"{value!r} has {len(items)} entries: it is not {what} (must have exactly {self.size})", None
         nums: list[float] = []
         for i, v in enumerate(items):
@@ -139,7 +138,7 @@ class Param:
                 return None, f"{v!r} is too large", entry
             if not math.isfinite(x):
                 return None, f"{v!r} is not finite", entry
-            nums.append(float(v))
+            nums.append(x)
         if self.kind == "interval":
             assert self.lower is not None and self.upper is not None
             if not nums[0] < nums[1]:

@@ -90,10 +90,12 @@ class RuntimeParam:
     rule: str                       # the rule in words, a C string literal's contents
 
 
-def _range_test(x: str, r: Range, real: str) -> str:
-    lo = f"({real}){c_float(r.lo)} {'<' if r.lo_open else '<='} {x}"
-    hi = f"{x} {'<' if r.hi_open else '<='} ({real}){c_float(r.hi)}"
-    return f"{lo} && {hi}"
+def _range_test(x: str, r: Range, real: str | None) -> str:
+    """C for r holding x: reals as literals of the solver's real type, integers (real None) as ints."""
+    def lit(v: float) -> str:
+        return str(int(v)) if real is None else f"({real}){c_float(v)}"
+
+    return f"{lit(r.lo)} {'<' if r.lo_open else '<='} {x} && {x} {'<' if r.hi_open else '<='} {lit(r.hi)}"
 
 
 def _check_exprs(p: Param, real: str) -> tuple[str, ...]:
@@ -102,8 +104,7 @@ def _check_exprs(p: Param, real: str) -> tuple[str, ...]:
         return (f"{f} == 0 || {f} == 1",)
     if p.kind == "integer":
         assert p.valid is not None
-        return (f"{int(p.valid.lo)} {'<' if p.valid.lo_open else '<='} {f} && {f} {'<' if p.valid.hi_open else '<='} "
-                f"{int(p.valid.hi)}",)
+        return (_range_test(f, p.valid, None),)
     if p.kind == "interval":
         assert p.lower is not None and p.upper is not None
         return (_range_test(f + "[0]", p.lower, real), _range_test(f + "[1]", p.upper, real), f"{f}[0] < {f}[1]")

@@ -74,16 +74,16 @@ FLOAT_MIN_QP_TOL = 1e-6
 
 @dataclass(frozen=True)
 class Rule:
-    """How one spec value is checked. ``kind``: number, integer, vector, interval, choice, name."""
+    """How one spec value is checked. ``kind``: number, integer, boolean, choice, name, or param (a
+    runtime parameter, checked by its row of the parameter table)."""
 
     kind: str
     doc: str
     gt: float | None = None
     ge: float | None = None
     le: float | None = None
-    length: int | None = None
     choices: tuple[str, ...] = ()
-    param: Param | None = None  # kind "param": a runtime parameter, checked by its row of the table
+    param: Param | None = None
 
     def check(self, path: str, value: Any) -> tuple[Any, list[str]]:
         """Return the normalised value and the problems found (empty when valid)."""
@@ -115,30 +115,6 @@ class Rule:
         if isinstance(value, bool) or not isinstance(value, int):
             return None, [f"{path}: {value!r} has the wrong type: must be an integer"]
         return int(value), self._range_problems(path, int(value))
-
-    # -- sequences ------------------------------------------------------------------------------
-    def _check_vector(self, path: str, value: Any) -> tuple[Any, list[str]]:
-        if not isinstance(value, (list, tuple)):
-            return None, [f"{path}: {value!r} has the wrong type: must be a list of {self.length} numbers"]
-        if len(value) != self.length:
-            return None, [f"{path}: {value!r} has {len(value)} entries: must have exactly {self.length}"]
-        out: list[float] = []
-        problems: list[str] = []
-        for i, v in enumerate(value):
-            x, p = self._check_number(f"{path}[{i}]", v)
-            problems += p
-            out.append(x)
-        return tuple(out), problems
-
-    def _check_interval(self, path: str, value: Any) -> tuple[Any, list[str]]:
-        if not isinstance(value, (list, tuple)) or len(value) != 2:
-            return None, [f"{path}: {value!r} is not an interval: must be [lower, upper]"]
-        lo, p_lo = Rule("number", self.doc)._check_number(f"{path}[0]", value[0])
-        hi, p_hi = Rule("number", self.doc)._check_number(f"{path}[1]", value[1])
-        problems = p_lo + p_hi
-        if not problems and not lo < hi:
-            problems.append(f"{path}: {list(value)!r} is reversed or empty: lower bound must be < upper bound")
-        return (lo, hi), problems
 
     def _check_param(self, path: str, value: Any) -> tuple[Any, list[str]]:
         assert self.param is not None
@@ -188,18 +164,6 @@ def number(default: float, doc: str, *, gt: float | None = None, ge: float | Non
 
 def integer(default: int, doc: str, *, ge: float | None = None, le: float | None = None) -> Any:
     return _field(default, Rule("integer", doc, ge=ge, le=le))
-
-
-def vector(default: tuple[float, ...], doc: str, *, ge: float | None = None, le: float | None = None) -> Any:
-    return _field(default, Rule("vector", doc, ge=ge, le=le, length=len(default)))
-
-
-def interval(default: tuple[float, float], doc: str) -> Any:
-    return _field(default, Rule("interval", doc))
-
-
-def boolean(default: bool, doc: str) -> Any:
-    return _field(default, Rule("boolean", doc))
 
 
 def choice(default: str, doc: str, choices: tuple[str, ...]) -> Any:
