@@ -98,6 +98,7 @@ class Solver:
         self._params_check = fn("params_check")
         self._params_rule = fn("params_rule")
         self._params_staged = ffi.new(f"{name}_params *")
+        self._params_size = ffi.sizeof(f"{name}_params")
         self.log: StepLog | None = None
         # One solver, one step at a time: cffi releases the GIL in C, and two threads stepping the
         # same solver memory crashed. Callers from several threads are serialised.
@@ -244,14 +245,14 @@ class Solver:
         # The C check has the last word (the same table): a combination it refuses changes nothing.
         ffi = self._ffi
         with self._lock:
-            ffi.memmove(self._params_staged, self._params, ffi.sizeof(f"{self.name}_params"))
+            ffi.memmove(self._params_staged, self._params, self._params_size)
             for key, v in staged:
                 setattr(self._params_staged, key, v)
             broken = int(self._params_check(self._params_staged))
             if broken:
                 rule = ffi.string(self._params_rule(broken)).decode()
                 raise ValueError(f"invalid runtime parameter(s), none changed: {rule}")
-            ffi.memmove(self._params, self._params_staged, ffi.sizeof(f"{self.name}_params"))
+            ffi.memmove(self._params, self._params_staged, self._params_size)
 
     def status_message(self, status: int) -> str:
         return str(self._ffi.string(self._status_message(status)).decode())

@@ -193,15 +193,19 @@ def pin_to_one_core() -> str:
         return f"not pinned ({err})"
 
 
-def machine_description() -> str:
-    cpu = platform.processor() or platform.machine()
+def cpu_name() -> str | None:
+    """The CPU's model name from /proc/cpuinfo (None where there is none)."""
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
+                return line.split(":", 1)[1].strip()
     except OSError:
         pass
+    return None
+
+
+def machine_description() -> str:
+    cpu = cpu_name() or platform.processor() or platform.machine()
     return f"{cpu}, {os.cpu_count()} CPUs, Python {platform.python_version()}, {platform.system()}"
 
 

@@ -55,6 +55,7 @@ from ..bindings import load
 from ..codegen.cli import non_negative_int
 from ..codegen.reference_nlp import ReferenceNlp
 from ..codegen.spec import Spec, load_spec, resolve_spec
+from .bench import cpu_name
 from .peers.acados_client import (
     ACADOS_PACKAGE,
     DEFAULT_ACADOS_VENV,
@@ -151,14 +152,7 @@ def _load_spec(item: Spec | str | Path) -> Spec:
 
 
 def machine_description() -> dict[str, str]:
-    cpu = platform.processor() or "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+    cpu = cpu_name() or platform.processor() or "unknown CPU"
 
     def version(cmd: list[str]) -> str:
         try:
