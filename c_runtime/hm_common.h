@@ -53,6 +53,10 @@
 #define hm_exp expf
 #define hm_fmax fmaxf
 #define hm_fmin fminf
+#define hm_atan2 atan2f
+#define hm_cos cosf
+#define hm_sin sinf
+#define hm_floor floorf
 #define HM_EPS 1.1920929e-07f
 #define HM_INF 1.0e30f
 #else
@@ -62,6 +66,10 @@
 #define hm_exp exp
 #define hm_fmax fmax
 #define hm_fmin fmin
+#define hm_atan2 atan2
+#define hm_cos cos
+#define hm_sin sin
+#define hm_floor floor
 #define HM_EPS 2.220446049250313e-16
 #define HM_INF 1.0e30
 #endif

@@ -1,6 +1,6 @@
 /*
  * hm_status.h: the status codes of a QP solve and of a solver step, and the reasons for a
- * protective stop, as tables: one X(ID, value, name, message) row each. This is their single source:
+ * protective stop, and the outcomes of a controller step, as tables: one X(ID, value, name, message) row each. This is their single source:
  * the runtime's enums and messages expand these rows, and the generator reads this file
  * (humanmpc.codegen.status) for the public constants of the generated header (<NAME>_QP_SOLVED,
  * <NAME>_STATUS_OK, <NAME>_STOP_DEADLINE, ...), the manifest and the Python enums. The values are
@@ -38,6 +38,14 @@
     X(STOP_NONFINITE, 5, nonfinite, "protective stop (C1): non-finite number in the solution") \
     X(STOP_HUMAN_TOO_CLOSE, 6, human_too_close, "protective stop (C2): a human is within d_h of the robot") \
     X(STOP_UNSAFE_PLAN, 7, unsafe_plan, "protective stop (C2): the planned path comes within d_h of a human")
+
+/* What a controller step ended with (controller.c): what the robot is doing, in one word. */
+#define HM_OUTCOME_TABLE(X) \
+    X(OUTCOME_FOLLOWING, 0, following, "following the path towards the goal") \
+    X(OUTCOME_GOAL_REACHED, 1, goal_reached, "goal reached: braking to a standstill") \
+    X(OUTCOME_STOPPED, 2, stopped, "protective stop in force: see stop_reason") \
+    X(OUTCOME_STALLED, 3, stalled, "stalled: no progress towards the goal for stall_time seconds while not stopping") \
+    X(OUTCOME_NO_GOAL, 4, no_goal, "no path and no goal given: braking to a standstill")
 
 /* Row expanders: an enum constant HM_<ID> = value, and a switch case returning the message. */
 #define HM_STATUS_ENUM_ROW(id, value, name, message) HM_##id = value,

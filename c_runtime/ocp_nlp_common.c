@@ -21,3 +21,26 @@ HM_FUNC int ocp_nlp_qp_usable(int status)
 {
     return status == HM_QP_SOLVED || status == HM_QP_MAX_ITER;
 }
+
+/* Deadline hook of the QP iterations. */
+HM_FUNC int ocp_nlp_deadline_passed(void *ctx)
+{
+    const hm_solver *s = (const hm_solver *)ctx;
+    return s->clock != 0 && s->clock(s->clock_ctx) - s->t_start > s->deadline_ns;
+}
+
+HM_FUNC void ocp_nlp_start_clock(hm_solver *s, unsigned long long t_start)
+{
+    /* deadline_ms * 1e6 in nanoseconds, without a real -> 64-bit integer conversion: on a
+     * single-precision FPU libgcc does that one in soft double. Whole milliseconds and the fraction
+     * are converted to 32 bits each (one FPU instruction); absurd or NaN deadlines are capped at
+     * ~50 days (the monitor refuses non-positive or non-finite ones before any solving). */
+    hm_real ms = s->params.deadline_ms;
+    unsigned long whole, frac_ns;
+    if (!(ms >= HM_R(0.0))) ms = HM_R(0.0);
+    if (ms > HM_R(4.0e9)) ms = HM_R(4.0e9);
+    whole = (unsigned long)ms;
+    frac_ns = (unsigned long)((ms - (hm_real)whole) * HM_R(1e6));
+    s->t_start = t_start;
+    s->deadline_ns = (unsigned long long)whole * 1000000ULL + frac_ns;
+}

@@ -46,6 +46,10 @@ HM_FUNC int ocp_nlp_clamp_humans(const hm_input *in);
 /* The solver's clock now (0 without a clock). */
 HM_FUNC unsigned long long ocp_nlp_now(const hm_solver *s);
 
+/* The deadline of a step: params.deadline_ms from t_start (a clock reading), polled by
+ * ocp_nlp_deadline_passed (the QP iterations' hook; ctx is the solver). */
+HM_FUNC void ocp_nlp_start_clock(hm_solver *s, unsigned long long t_start);
+HM_FUNC int ocp_nlp_deadline_passed(void *ctx);
 /* A QP status whose solution is a step the SQP may take (solved, or at its iteration limit). */
 HM_FUNC int ocp_nlp_qp_usable(int status);
 

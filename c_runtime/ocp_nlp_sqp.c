@@ -51,10 +51,12 @@ HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
     s->screen_radius[0] = HM_INF;
 }
 
-HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol)
+/* timed: under the deadline of params.deadline_ms from t0 (polled inside the QPs and between the
+ * iterations; passing it is a protective stop), as a recovery inside a control period needs. */
+static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
+                               int timed, unsigned long long t0)
 {
-    const unsigned long long t0 = ocp_nlp_now(s);
-    int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER, reason;
+    int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER, reason, late = 0;
     ocp_nlp_clear_output(out);
     s->qp_solves = 0;
     reason = ocp_nlp_check_before(s, in);
@@ -77,7 +79,16 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
     s->ipm_arg.recurrence = 0;
     /* and all of them from the cold start (keeping none, so the next RTI step starts cold too) */
     s->ipm_arg.warm_mu = HM_R(0.0);
+    if (timed) {
+        ocp_nlp_start_clock(s, t0);
+        s->ipm_arg.should_stop = ocp_nlp_deadline_passed;
+        s->ipm_arg.stop_ctx = s;
+    }
     for (k = 0; k < max_iter; k++) {
+        if (timed && ocp_nlp_deadline_passed(s)) {
+            late = 1;
+            break;
+        }
         ocp_nlp_linearize(s, in, k > 0);
         ocp_nlp_set_x0(s, in);
         ocp_nlp_residuals(s, out);
@@ -88,9 +99,12 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
         qp_status = ocp_nlp_qp_line_search_step(s, in, tol, 0, &out->qp_iterations);
         if (!ocp_nlp_qp_usable(qp_status)) {
             status = HM_STATUS_QP_FAILED;
+            late = qp_status == HM_QP_TIMEOUT;
             break;
         }
     }
+    s->ipm_arg.should_stop = 0;
+    s->ipm_arg.stop_ctx = 0;
     if (k == max_iter) {
         /* Report the residuals at the final iterate. */
         ocp_nlp_linearize(s, in, 1);
@@ -107,7 +121,9 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
     out->sqp_iterations = k;
     out->qp_solves = s->qp_solves;
     reason = HM_STOP_NONE;
-    if (status == HM_STATUS_QP_FAILED) {
+    if (late) {
+        reason = HM_STOP_DEADLINE;
+    } else if (status == HM_STATUS_QP_FAILED) {
         reason = HM_STOP_QP_FAILED;
     } else {
         reason = ocp_nlp_check_plan(s, in);
@@ -120,6 +136,17 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
     out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
     out->time_total_ms = out->time_feedback_ms;
     return status;
+}
+
+HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol)
+{
+    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, 0, ocp_nlp_now(s));
+}
+
+HM_FUNC int ocp_nlp_sqp_solve_timed(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
+                                    unsigned long long t0)
+{
+    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, 1, t0);
 }
 
 HM_FUNC const char *ocp_nlp_status_message(int status)

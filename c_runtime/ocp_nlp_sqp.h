@@ -10,6 +10,10 @@
 HM_FUNC void ocp_nlp_sqp_init(hm_solver *s, const hm_params *params);
 HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s);
 HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol);
+/* The same under the step's deadline (params.deadline_ms from the clock reading t0): a late SQP ends
+ * in a protective stop for the deadline. */
+HM_FUNC int ocp_nlp_sqp_solve_timed(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
+                                    unsigned long long t0);
 HM_FUNC const char *ocp_nlp_status_message(int status);
 
 #endif /* OCP_NLP_SQP_H */

@@ -55,7 +55,7 @@ class Param:
     name: str                  # field of <name>_params, keyword of Solver.set_params
     key: str                   # spec key path whose value is the default
     kind: str                  # one of KINDS
-    default: Any               # the paper's value (the spec's default)
+    default: Any               # the spec's default (the evaluation's winning value, docs/evaluation.md)
     doc: str
     unit: str = ""
     size: int = 1              # entries in C (vectors, intervals)
@@ -65,6 +65,8 @@ class Param:
     problem: bool = False      # part of the optimal control problem itself (the Ipopt reference's parameters)
     spec_choices: tuple[str, ...] = field(default=())  # flag set in the spec by a choice: its index is the flag
     reason: str = ""           # why the range is what it is, said with the rule
+    paper: Any = None          # the paper's value, when the default is not (spec `preset: paper`)
+    controller: bool = False   # read by the controller around the solver (the solver ignores it)
 
     @property
     def described(self) -> str:
@@ -180,14 +182,14 @@ _WEIGHT = Range(0.0, 1e9)
 _DIST = Range(0.0, 100.0)
 
 PARAMS: tuple[Param, ...] = (
-    Param("w_goal", "weights.goal", "vector", (0.5, 0.5, 0.0, 250.0), "stage weights on x - g", size=4,
-          valid=_WEIGHT, problem=True),
+    Param("w_goal", "weights.goal", "vector", (0.5, 0.5, 0.0, 50.0), "stage weights on x - g", size=4,
+          valid=_WEIGHT, problem=True, paper=(0.5, 0.5, 0.0, 250.0)),
     Param("w_goal_terminal", "weights.goal_terminal", "vector", (40.0, 40.0, 2.0, 0.0),
           "terminal weights on x_N - g", size=4, valid=_WEIGHT, problem=True),
     Param("w_control", "weights.control", "vector", (0.0, 0.0), "stage weights on u = [a, omega]", size=2,
           valid=_WEIGHT, problem=True),
-    Param("q", "collision_cost.q", "real", 2.0, "height of the collision potential", valid=Range(0.0, 1e6),
-          problem=True),
+    Param("q", "collision_cost.q", "real", 50.0, "height of the collision potential", valid=Range(0.0, 1e6),
+          problem=True, paper=2.0),
     Param("d_th", "collision_cost.d_th", "real", 1.0, "distance at which the potential is q/2", unit="m",
           valid=_DIST, problem=True),
     Param("kappa", "collision_cost.kappa", "real", 5.0, "steepness of the potential", unit="1/m",
@@ -200,8 +202,8 @@ PARAMS: tuple[Param, ...] = (
           valid=_WEIGHT),
     Param("d_s", "obstacle.d_s", "real", 0.5, "soft minimum distance to the closest obstacle", unit="m",
           valid=_DIST, problem=True),
-    Param("slack_l1", "obstacle.slack_l1", "real", 100.0, "L1 penalty on the obstacle slack", valid=_WEIGHT,
-          problem=True),
+    Param("slack_l1", "obstacle.slack_l1", "real", 1000.0, "L1 penalty on the obstacle slack", valid=_WEIGHT,
+          problem=True, paper=100.0),
     Param("slack_l2", "obstacle.slack_l2", "real", 100.0, "L2 penalty on the obstacle slack (0.5*l2*s^2)",
           valid=_WEIGHT, problem=True),
     # The bounds must admit the protective stop: standstill (v = 0), braking (a < 0) and no turning.
@@ -226,14 +228,59 @@ PARAMS: tuple[Param, ...] = (
     Param("row_screening", "solver.row_screening", "flag", True,
           "leave distance rows far from binding out of each QP and check them at its solution (re-solving "
           "with any that are violated): the same solution, at the cost of the rows that matter"),
-    Param("exact_hessian", "solver.hessian", "flag", "gauss_newton",
+    Param("exact_hessian", "solver.hessian", "flag", "exact",
           "RTI Hessian: gauss_newton (acados' default), or exact: the Hessian of the Lagrangian at the shifted "
           "multipliers, projected per stage onto the PSD cone (no omega chatter when the goal is far)",
-          spec_choices=("gauss_newton", "exact")),
+          spec_choices=("gauss_newton", "exact"), paper="gauss_newton"),
+    # The controller around the solver (c_runtime/controller*.c). The defaults are the evaluation's
+    # (docs/evaluation.md); the paper's values hand the OCP the final goal with nothing around it but the
+    # goal taper.
+    Param("v_ref", "controller.v_ref", "real", 0.8, "cruising speed the OCP is asked to track", unit="m/s",
+          valid=Range(0.0, 100.0, lo_open=True), controller=True),
+    Param("speed_limit", "controller.speed_limit", "real", 0.8,
+          "cap on the planned speed (the OCP's upper speed bound is min(v_bounds upper, speed_limit))", unit="m/s",
+          valid=Range(0.0, 100.0, lo_open=True), controller=True, paper=100.0),
+    Param("lookahead", "controller.lookahead", "real", 0.0,
+          "carrot distance along the path (0: v_ref * T, the plan's length at cruising speed)", unit="m",
+          valid=Range(0.0, 1e4), controller=True, paper=1e4),
+    Param("goal_taper", "controller.goal_taper", "real", 0.5,
+          "the speed to track is at most goal_taper times the distance left to the goal", unit="1/s",
+          valid=Range(0.0, 100.0, lo_open=True), controller=True),
+    Param("goal_tolerance", "controller.goal_tolerance", "real", 0.3,
+          "distance to the final goal at which it counts as reached (the robot then brakes)", unit="m",
+          valid=Range(0.0, 100.0, lo_open=True), controller=True),
+    Param("approach", "controller.approach", "flag", True,
+          "once the horizon reaches the goal: track no speed, weigh the position at every node "
+          "(approach_position) and arrive at rest (approach_stop)", controller=True, paper=False),
+    Param("approach_position", "controller.approach_position", "real", 5.0,
+          "stage weight on px, py during the approach", valid=_WEIGHT, controller=True),
+    Param("approach_stop", "controller.approach_stop", "real", 40.0,
+          "terminal weight on v (to 0) during the approach", valid=_WEIGHT, controller=True),
+    Param("loop_ratio", "controller.loop_ratio", "real", 0.5,
+          "a plan whose end is nearer its start than loop_ratio times its length is a loop (0: never)",
+          valid=Range(0.0, 1.0, hi_open=True), controller=True, paper=0.0),
+    Param("loop_min_length", "controller.loop_min_length", "real", 1.0,
+          "plans shorter than this are never loops (stopping, waiting, arriving)", unit="m", valid=_DIST,
+          controller=True),
+    Param("recovery_iterations", "controller.recovery_iterations", "integer", 10,
+          "SQP iterations of a recovery from a cold start after a loop or a stall (0: no recovery)",
+          valid=Range(0, 100), controller=True, paper=0),
+    Param("stall_time", "controller.stall_time", "real", 5.0,
+          "time without progress towards the goal, while not stopping, after which the robot is stalled",
+          unit="s", valid=Range(0.0, 1e4, lo_open=True), controller=True),
+    Param("stall_distance", "controller.stall_distance", "real", 0.2,
+          "the distance left to the goal must shrink by this much to count as progress", unit="m",
+          valid=_DIST, controller=True),
 )
 
 BY_KEY: Mapping[str, Param] = {p.key: p for p in PARAMS}
 PROBLEM_PARAMS: tuple[Param, ...] = tuple(p for p in PARAMS if p.problem)
+CONTROLLER_PARAMS: tuple[Param, ...] = tuple(p for p in PARAMS if p.controller)
+
+
+def paper_values() -> dict[str, Any]:
+    """Spec key -> the paper's value, for every parameter whose default is not the paper's."""
+    return {p.key: p.paper for p in PARAMS if p.paper is not None}
 
 
 def spec_params(spec: Any) -> dict[str, Any]:

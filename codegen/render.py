@@ -48,6 +48,10 @@ RUNTIME_SOURCES = (
     "ocp_nlp_out.c",
     "ocp_nlp_rti.c",
     "ocp_nlp_sqp.c",
+    "controller_common.c",
+    "controller_goal.c",
+    "controller_people.c",
+    "controller.c",
 )
 
 # Template -> file name in the generated folder ({name} is the spec's name).
@@ -167,6 +171,9 @@ def template_context(spec: Spec, functions: list[EmittedFunction], real: str) ->
         "NH": int(spec.humans.max),
         "NG": int(spec.n_rows),
         "NH_ALLOC": max(1, int(spec.humans.max)),  # C has no zero-length arrays
+        "NT": int(spec.controller.max_tracks),
+        "NP": int(spec.controller.max_path_points),
+        "NK": int(spec.controller.max_obstacle_points),
         "runtime_sources": RUNTIME_SOURCES,
         "dt": c_float(spec.dt),
         "statuses": status_tables(),

@@ -23,7 +23,7 @@ from typing import Any, cast
 
 import yaml
 
-from .params import BY_KEY, Param
+from .params import BY_KEY, Param, paper_values
 
 
 class SpecError(ValueError):
@@ -249,8 +249,38 @@ class Monitor:
 
 
 @dataclass(frozen=True)
+class Controller:
+    max_tracks: int = integer(32, "M: tracked people the controller takes per step (a fixed size, >= humans.max)",
+                              ge=1, le=1000)
+    max_path_points: int = integer(256, "P: waypoints of the reference path (a fixed size)", ge=2, le=100_000)
+    max_obstacle_points: int = integer(256, "K: obstacle points (a scan's or a costmap's) per step (a fixed size)",
+                                       ge=1, le=100_000)
+    v_ref: float = param("controller.v_ref")
+    speed_limit: float = param("controller.speed_limit")
+    lookahead: float = param("controller.lookahead")
+    goal_taper: float = param("controller.goal_taper")
+    goal_tolerance: float = param("controller.goal_tolerance")
+    approach: bool = param("controller.approach")
+    approach_position: float = param("controller.approach_position")
+    approach_stop: float = param("controller.approach_stop")
+    loop_ratio: float = param("controller.loop_ratio")
+    loop_min_length: float = param("controller.loop_min_length")
+    recovery_iterations: int = param("controller.recovery_iterations")
+    stall_time: float = param("controller.stall_time")
+    stall_distance: float = param("controller.stall_distance")
+
+
+PRESETS = ("humanmpc", "paper")
+
+
+@dataclass(frozen=True)
 class Spec:
     name: str = _field("paper", Rule("name", "C identifier; prefix of every public C name"))
+    preset: str = choice(
+        "humanmpc", "defaults of the keys not given: humanmpc (the values that won the evaluation, "
+        "docs/evaluation.md) or paper (the paper's values exactly: its weights, Gauss-Newton, the final goal "
+        "with nothing around the OCP but the goal taper)", PRESETS,
+    )
     precision: str = choice(
         "double", "real type of the generated C: double, or float for single-precision FPUs (Cortex-M4; "
         f"needs solver.qp_tol >= {FLOAT_MIN_QP_TOL:g}, >= {10 * FLOAT_MIN_QP_TOL:g} with solver.line_search)",
@@ -265,6 +295,12 @@ class Spec:
     bounds: Bounds = field(default_factory=Bounds)
     solver: Solver = field(default_factory=Solver)
     monitor: Monitor = field(default_factory=Monitor)
+    controller: Controller = field(default_factory=Controller)
+
+    @staticmethod
+    def paper(name: str = "paper") -> Spec:
+        """The paper's configuration (``preset: paper``)."""
+        return resolve_spec({"name": name, "preset": "paper"})
 
     @property
     def dt(self) -> float:
@@ -340,6 +376,10 @@ def _resolve_section(cls: type, data: Any, path: str, problems: list[str]) -> An
 def _cross_checks(spec: Spec) -> list[str]:
     """Rules that involve more than one key."""
     problems = []
+    if spec.controller.max_tracks < spec.humans.max:
+        problems.append(f"controller.max_tracks: {spec.controller.max_tracks} is below humans.max "
+                        f"({spec.humans.max}): the controller chooses the solver's N_h people among its tracks, "
+                        "so it must take at least as many")
     floor = FLOAT_MIN_QP_TOL * (10.0 if spec.solver.line_search else 1.0)
     if spec.precision == "float" and spec.solver.qp_tol < floor:
         why = " (the line search solves its QPs to 0.1 * qp_tol)" if spec.solver.line_search else ""
@@ -351,9 +391,30 @@ def _cross_checks(spec: Spec) -> list[str]:
     return problems
 
 
+def _with_defaults(data: Mapping[str, Any], defaults: Mapping[str, Any]) -> dict[str, Any]:
+    """data with the values of defaults (dotted key paths) where data gives none."""
+    out: dict[str, Any] = dict(data)
+    for key, value in defaults.items():
+        *sections, leaf = key.split(".")
+        node = out
+        for section in sections:
+            sub = node.get(section)
+            if sub is None:
+                sub = {}
+            elif not isinstance(sub, Mapping):
+                break  # a wrong type: reported by the resolution
+            node[section] = sub = dict(sub)
+            node = sub
+        else:
+            node.setdefault(leaf, list(value) if isinstance(value, tuple) else value)
+    return out
+
+
 def resolve_spec(data: Any, source: str = "spec") -> Spec:
     """Validate a parsed spec (a mapping, or None for all defaults) and fill in the defaults."""
     problems: list[str] = []
+    if isinstance(data, Mapping) and data.get("preset") == "paper":
+        data = _with_defaults(data, paper_values())
     spec = _resolve_section(Spec, data, "", problems)
     if not problems:
         problems = _cross_checks(spec)

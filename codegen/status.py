@@ -13,7 +13,8 @@ from functools import cache
 
 from .resources import runtime_dir
 
-TABLES = {"qp_status": "HM_QP_STATUS_TABLE", "status": "HM_STATUS_TABLE", "stop_reason": "HM_STOP_REASON_TABLE"}
+TABLES = {"qp_status": "HM_QP_STATUS_TABLE", "status": "HM_STATUS_TABLE", "stop_reason": "HM_STOP_REASON_TABLE",
+          "outcome": "HM_OUTCOME_TABLE"}
 _ROW = re.compile(r'^\s*X\(([A-Z][A-Z0-9_]*), (-?\d+), ([a-z][a-z0-9_]*), "([^"\\]*)"\)\s*\\?\s*$')
 
 

@@ -18,28 +18,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .codegen.params import Param
-from .results import StepResult
+from .controller import Controller
+from .results import StepResult, record_dtype
+from .runtime_params import RuntimeParams
 from .steplog import StepLog
-
-
-def _numpy_type(t: Any) -> Any:
-    """The numpy dtype of a cffi primitive or (nested) array type."""
-    shape: list[int] = []
-    while t.kind == "array":
-        shape.append(t.length)
-        t = t.item
-    base = {"double": np.float64, "float": np.float32, "int": np.int32}.get(t.cname)
-    if t.kind != "primitive" or base is None:
-        raise TypeError(f"unexpected field type {t.cname} in the output struct")
-    return (base, tuple(shape)) if shape else base
-
-
-def record_dtype(ffi: Any, ctype: str) -> np.dtype:
-    """A structured numpy dtype with the layout of the C struct ``ctype`` (cffi's offsets)."""
-    t = ffi.typeof(ctype)
-    fields = list(t.fields)
-    return np.dtype({"names": [f for f, _ in fields], "formats": [_numpy_type(ft.type) for _, ft in fields],
-                     "offsets": [ft.offset for _, ft in fields], "itemsize": ffi.sizeof(ctype)})
 
 
 def _view(ffi: Any, cdata: Any, shape: tuple[int, ...], dtype: Any = np.float64) -> Any:
@@ -90,19 +72,12 @@ class Solver:
         self._h_pred_first = [h_pred[:, :k] for k in range(nh_alloc + 1)]
         self._out_buffer = ffi.buffer(self._out)
         self._out_dtype = record_dtype(ffi, f"{name}_output")
-        self._param_fields = {f: t.type for f, t in ffi.typeof(f"{name}_params").fields}
-        self._param_rows = {p.name: p for p in params_table}
-        if list(self._param_rows) != list(self._param_fields):
-            raise ValueError(f"the manifest's parameter table {list(self._param_rows)} does not match the library's "
-                             f"params struct {list(self._param_fields)}")
-        self._params_check = fn("params_check")
-        self._params_rule = fn("params_rule")
-        self._params_staged = ffi.new(f"{name}_params *")
-        self._params_size = ffi.sizeof(f"{name}_params")
         self.log: StepLog | None = None
         # One solver, one step at a time: cffi releases the GIL in C, and two threads stepping the
         # same solver memory crashed. Callers from several threads are serialised.
         self._lock = threading.Lock()
+        self._table = params_table
+        self._runtime_params = RuntimeParams(ffi, lib, name, self._params, params_table, self._lock)
 
     def start_log(self, capacity: int = 10000) -> StepLog:
         """Keep the newest `capacity` steps (status, stop reason, timings, closest human) in self.log."""
@@ -213,11 +188,7 @@ class Solver:
     @property
     def params(self) -> dict[str, Any]:
         """The runtime parameters now in force."""
-        out: dict[str, Any] = {}
-        for field, ftype in self._param_fields.items():
-            value = getattr(self._params, field)
-            out[field] = tuple(value) if ftype.kind == "array" else value
-        return out
+        return self._runtime_params.values
 
     def set_params(self, **values: Any) -> None:
         """Change runtime parameters, e.g. set_params(q=3.0, w_goal=[1, 1, 0, 100]).
@@ -227,32 +198,12 @@ class Solver:
         lists every value that breaks its rule (a KeyError names unknown parameters), and nothing is
         changed.
         """
-        unknown = [key for key in values if key not in self._param_rows]
-        if unknown:
-            raise KeyError(f"unknown parameter {', '.join(repr(k) for k in unknown)}; parameters are "
-                           f"{', '.join(self._param_rows)}")
-        problems: list[str] = []
-        staged: list[tuple[str, Any]] = []
-        for key, value in values.items():
-            row = self._param_rows[key]
-            checked, why = row.check(value)
-            if why is not None:
-                problems.append(f"{key}: {why}: {row.name} must be {row.rule}")
-            else:
-                staged.append((key, list(checked) if row.size > 1 else checked))
-        if problems:
-            raise ValueError("invalid runtime parameter(s), none changed:\n  - " + "\n  - ".join(problems))
-        # The C check has the last word (the same table): a combination it refuses changes nothing.
-        ffi = self._ffi
-        with self._lock:
-            ffi.memmove(self._params_staged, self._params, self._params_size)
-            for key, v in staged:
-                setattr(self._params_staged, key, v)
-            broken = int(self._params_check(self._params_staged))
-            if broken:
-                rule = ffi.string(self._params_rule(broken)).decode()
-                raise ValueError(f"invalid runtime parameter(s), none changed: {rule}")
-            ffi.memmove(self._params, self._params_staged, self._params_size)
+        self._runtime_params.set(**values)
+
+    def controller(self) -> Controller:
+        """A new navigation controller over this package's library (its own solver memory and
+        parameters, the spec's defaults): ``humanmpc.load(DIR).controller()``."""
+        return Controller(self.name, self.dims, self._ffi, self._lib, self._table)
 
     def status_message(self, status: int) -> str:
         return str(self._ffi.string(self._status_message(status)).decode())

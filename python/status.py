@@ -1,4 +1,4 @@
-"""The solver's status codes, QP status codes and stop reasons as Python enums.
+"""The solver's status codes, QP status codes and stop reasons, and the controller's outcomes as Python enums.
 
 From their single source, the C runtime's table (runtime/hm_status.h, read by
 humanmpc.codegen.status): the same values and messages as the generated C, member names in upper
@@ -31,8 +31,10 @@ def _enum(class_name: str, key: str) -> type[_Coded]:
 QpStatus = _enum("QpStatus", "qp_status")
 Status = _enum("Status", "status")
 StopReason = _enum("StopReason", "stop_reason")
+Outcome = _enum("Outcome", "outcome")
 
 # Lower-case names by value, as StepResult and the logs print them (no stop: None).
 STATUS_NAMES: dict[int, str] = {int(s): s.name.lower() for s in Status}
 QP_STATUS_NAMES: dict[int, str] = {int(s): s.name.lower() for s in QpStatus}
 STOP_REASONS: dict[int, str | None] = {int(s): (None if s == 0 else s.name.lower()) for s in StopReason}
+OUTCOME_NAMES: dict[int, str] = {int(s): s.name.lower() for s in Outcome}

@@ -27,7 +27,8 @@ def runtime_files(suffix: str) -> list[Path]:
 
 
 def layer(name: str) -> int:
-    """0 shared, 1 QP, 2 the NLP layer's common header and types, 3 the monitor, 4 the rest of the NLP.
+    """0 shared, 1 QP, 2 the NLP layer's common header and types, 3 the monitor, 4 the rest of the NLP,
+    5 the controller around the solver.
     hm_types.h, the umbrella of the QP layer's types (the public header includes it), is the QP layer's."""
     if name == "hm_types.h":
         return 1
@@ -39,6 +40,8 @@ def layer(name: str) -> int:
         return 2
     if name.startswith("monitor"):
         return 3
+    if name.startswith("controller"):
+        return 5
     assert name.startswith("ocp_nlp_"), name
     return 4
 

@@ -47,6 +47,14 @@ class Observation:
     robot: RobotModel = field(default_factory=RobotModel)
 
     @property
+    def humans_velocity(self) -> FloatArray:
+        """The tracker's velocity estimate of each human (k, 2) [m/s]: the slope of the constant-velocity
+        prediction over its first interval."""
+        if self.humans_pred.shape[0] < 2:
+            return np.zeros_like(self.humans_now)
+        return (self.humans_pred[1] - self.humans_pred[0]) / self.dt
+
+    @property
     def n_humans(self) -> int:
         return int(self.humans_now.shape[0])
 

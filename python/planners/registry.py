@@ -2,8 +2,8 @@
 
 ``register_planner("mpc", factory)`` adds a planner; the factory takes no argument and returns
 a fresh :class:`~humanmpc.planners.interface.Planner`. The DWB baseline is registered as ``"dwb"``, the
-generated MPC as ``"mpc"`` (the evaluation's configuration) and ``"mpc_paper"`` (the paper's OCP with
-its parameters and the final goal; :class:`~humanmpc.planners.mpc.MPCPlannerConfig`).
+generated C controller as ``"mpc"`` (the spec's defaults) and ``"mpc_paper"`` (the paper's parameters and
+the goal pose alone; :meth:`~humanmpc.planners.mpc.MPCPlanner.paper`).
 Evaluation workers are forked from the registering process, so registrations made before an
 evaluation starts are visible in the workers.
 """
@@ -50,9 +50,9 @@ def _make_mpc() -> Planner:
 
 
 def _make_mpc_paper() -> Planner:
-    from .mpc import MPCPlanner, MPCPlannerConfig
+    from .mpc import MPCPlanner
 
-    return MPCPlanner(config=MPCPlannerConfig.paper(), name="mpc_paper")
+    return MPCPlanner.paper(name="mpc_paper")
 
 
 register_planner("dwb", DWBPlanner)

@@ -1,0 +1,378 @@
+/*
+ * controller.c: the navigation controller (controller.h).
+ *
+ * One period: check the inputs; the goal the OCP sees (a carrot on the path) and, near the goal, the
+ * approach; the solver's parameters for this period (the caller's, with the approach weights and the
+ * speed limit); the people and the obstacle the OCP sees; one real-time iteration; a recovery by a
+ * bounded SQP from a cold start when its plan is a loop or the robot has stalled; the command.
+ *
+ * Why each piece (measured in the evaluation, docs/evaluation.md):
+ * - the speed taper: the OCP tracks v_ref, and with a constant v_ref the robot circles its goal at
+ *   cruising speed; the speed it tracks is at most goal_taper times the distance left.
+ * - the approach: once the horizon reaches the goal, a speed to track over all of it makes the plan
+ *   loop around the goal to spend its length; the approach drops that weight, weighs the position at
+ *   every node and asks for the goal at rest.
+ * - the loop recovery: a real-time iteration improves the last plan by one step, so it stays in the
+ *   local solution it is in; when that is a loop (its end nearer its start than loop_ratio times its
+ *   length), a few SQP iterations from a cold start find the direct one.
+ * - the stall: a robot that makes no progress while nothing stops it (a local solution in front of a
+ *   person who does not move) is reported as stalled, and a recovery is tried once per stall_time.
+ * - the slow follower: behind a slow walker on the robot's own line the plan that follows is a saddle
+ *   of the OCP, symmetric between passing left and right, where SQP iterations from any symmetric
+ *   start stay (measured: a person 1.1 m ahead at 0.15 m/s, cost 2467 following, 873 passing). A
+ *   robot that has gone slower than half the speed it tracks for stall_time tries a recovery from a
+ *   start that steps sideways, towards the carrot's side (left when it is straight ahead); its plan
+ *   is kept only when it costs less.
+ */
+#include "controller.h"
+
+#include "controller_goal.h"
+#include "controller_people.h"
+#include "monitor.h"
+#include "ocp_nlp_lin.h"
+#include "ocp_nlp_out.h"
+#include "ocp_nlp_rti.h"
+#include "ocp_nlp_screen.h"
+#include "ocp_nlp_sqp.h"
+#include "ocp_qp.h"
+
+/* The sideways start of a recovery from a slow or stalled state: this turn rate for the first second,
+ * the opposite for the next (a lateral step of about v * 0.5 m), then straight on. */
+#define CONTROLLER_NUDGE_OMEGA HM_R(0.5)
+#define CONTROLLER_NUDGE_SECONDS HM_R(1.0)
+
+static int controller_finite(hm_real v)
+{
+    return (v - v) == (v - v);
+}
+
+static int controller_point_ok(const hm_real *p)
+{
+    return controller_finite(p[0]) && controller_finite(p[1]) && hm_fabs(p[0]) <= HM_MONITOR_MAX_POSITION &&
+           hm_fabs(p[1]) <= HM_MONITOR_MAX_POSITION;
+}
+
+/* 1 when every input is usable: counts within their capacities, numbers finite and not absurd. */
+static int controller_input_ok(const hm_controller_input *cin)
+{
+    int i;
+    if (!controller_finite(cin->time) || !controller_point_ok(cin->pose)) return 0;
+    if (!(hm_fabs(cin->pose[2]) <= HM_MONITOR_MAX_ANGLE) || !(hm_fabs(cin->v) <= HM_MONITOR_MAX_SPEED) ||
+        !(hm_fabs(cin->omega) <= HM_MONITOR_MAX_SPEED))
+        return 0;
+    if (cin->n_path < 0 || cin->n_path > HM_MAX_PATH_POINTS || cin->n_tracks < 0 ||
+        cin->n_tracks > HM_MAX_TRACKS || cin->n_obstacles < 0 || cin->n_obstacles > HM_MAX_OBSTACLE_POINTS ||
+        (cin->has_goal != 0 && cin->has_goal != 1))
+        return 0;
+    if (cin->has_goal && (!controller_point_ok(cin->goal) || !(hm_fabs(cin->goal[2]) <= HM_MONITOR_MAX_ANGLE)))
+        return 0;
+    for (i = 0; i < cin->n_path; i++)
+        if (!controller_point_ok(cin->path[i])) return 0;
+    for (i = 0; i < cin->n_tracks; i++) {
+        const hm_real *t = cin->tracks[i];
+        const hm_real *c = cin->track_covariances[i];
+        if (!controller_point_ok(t) || !(hm_fabs(t[2]) <= HM_MONITOR_MAX_SPEED) ||
+            !(hm_fabs(t[3]) <= HM_MONITOR_MAX_SPEED))
+            return 0;
+        if (cin->track_has_covariance[i] != 0 && cin->track_has_covariance[i] != 1) return 0;
+        if (cin->track_has_covariance[i] &&
+            !(c[0] >= HM_R(0.0) && c[2] >= HM_R(0.0) && c[0] <= HM_R(1e6) && c[2] <= HM_R(1e6) &&
+              hm_fabs(c[1]) <= HM_R(1e6)))
+            return 0;
+    }
+    for (i = 0; i < cin->n_obstacles; i++)
+        if (!controller_point_ok(cin->obstacles[i])) return 0;
+    return 1;
+}
+
+HM_FUNC void controller_reset(hm_controller *c)
+{
+    ocp_nlp_sqp_reset(&c->solver);
+    c->has_goal = 0;
+    c->has_time = 0;
+    c->has_recovery = 0;
+    c->has_theta = 0;
+    c->best_left = HM_INF;
+    c->time_progress = HM_R(0.0);
+    c->time_brisk = HM_R(0.0);
+    c->time_last = HM_R(0.0);
+    c->time_recovery = HM_R(0.0);
+    c->theta = HM_R(0.0);
+}
+
+HM_FUNC void controller_init(hm_controller *c, const hm_params *params)
+{
+    int j;
+    c->params = *params;
+    ocp_nlp_sqp_init(&c->solver, params);
+    c->in.n_humans = 0;
+    c->in.has_obstacle = 0;
+    for (j = 0; j < 2; j++) c->in.obstacle[j] = HM_R(0.0);
+    controller_reset(c);
+}
+
+/* The solver's parameters for this period: the caller's, with the speed limit and, within the
+ * horizon's reach of the goal, the approach weights. Sets the goal's speed (in->goal[3]). */
+static void controller_solver_params(hm_controller *c, const hm_controller_goal *g)
+{
+    const hm_params *p = &c->params;
+    hm_params *sp = &c->solver.params;
+    const hm_real horizon = HM_R(HM_DT) * (hm_real)HM_N;
+    const hm_real cap = hm_fmin(p->v_bounds[1], p->speed_limit);
+    *sp = *p;
+    if (cap > p->v_bounds[0]) sp->v_bounds[1] = cap;
+    c->in.goal[3] = hm_fmin(p->v_ref, p->goal_taper * g->left);
+    if (p->approach && g->left < p->v_ref * horizon) {
+        sp->w_goal[3] = HM_R(0.0);
+        sp->w_goal[0] = sp->w_goal[1] = p->approach_position;
+        sp->w_goal_terminal[3] = p->approach_stop;
+        c->in.goal[3] = HM_R(0.0);
+    }
+}
+
+/* A planned path of at least loop_min_length metres whose end is nearer its start than loop_ratio
+ * times its length. */
+static int controller_is_loop(const hm_params *p, const hm_output *o)
+{
+    hm_real length = HM_R(0.0), dx, dy;
+    int n;
+    if (!(p->loop_ratio > HM_R(0.0))) return 0;
+    for (n = 0; n < HM_N; n++) {
+        dx = o->x[n + 1][0] - o->x[n][0];
+        dy = o->x[n + 1][1] - o->x[n][1];
+        length += hm_sqrt(dx * dx + dy * dy);
+    }
+    dx = o->x[HM_N][0] - o->x[0][0];
+    dy = o->x[HM_N][1] - o->x[0][1];
+    return length >= p->loop_min_length && hm_sqrt(dx * dx + dy * dy) < p->loop_ratio * length;
+}
+
+/* The start of a sideways recovery: the measured state, the speed the OCP tracks reached within the
+ * acceleration bounds, a step to the side (CONTROLLER_NUDGE_*), simulated by the model. */
+static void controller_nudge(hm_controller *c)
+{
+    hm_solver *s = &c->solver;
+    const hm_input *in = &c->in;
+    const hm_real a_min = s->params.a_bounds[0], a_max = s->params.a_bounds[1];
+    const hm_real dx = in->goal[0] - in->x0[0], dy = in->goal[1] - in->x0[1];
+    const hm_real lateral = -hm_sin(in->x0[2]) * dx + hm_cos(in->x0[2]) * dy;
+    const hm_real side = lateral < HM_R(-1e-3) ? HM_R(-1.0) : HM_R(1.0);
+    const hm_real v_goal = hm_fmax(in->goal[3], HM_R(0.5) * c->params.v_ref);
+    int n, i;
+    for (i = 0; i < HM_NX; i++) s->x[0][i] = in->x0[i];
+    for (n = 0; n < HM_N; n++) {
+        const hm_real t = HM_R(HM_DT) * (hm_real)n;
+        const hm_real w = t < CONTROLLER_NUDGE_SECONDS ? CONTROLLER_NUDGE_OMEGA
+                          : t < HM_R(2.0) * CONTROLLER_NUDGE_SECONDS ? -CONTROLLER_NUDGE_OMEGA : HM_R(0.0);
+        s->u[n][0] = hm_fmin(hm_fmax((v_goal - s->x[n][3]) / HM_R(HM_DT), a_min), a_max);
+        s->u[n][1] = hm_fmin(hm_fmax(side * w, s->params.omega_bounds[0]), s->params.omega_bounds[1]);
+        hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], s->qp.A[n], s->qp.B[n]);
+    }
+    s->dyn_fresh = 1;
+    ocp_qp_sol_set_zero(&s->mult);
+    ocp_nlp_screen_reach(s);
+    s->warm = 1; /* the SQP starts from this plan, not from a standstill guess */
+}
+
+/* A bounded SQP inside the period's deadline (counted from t0), from a cold start, or with sideways
+ * from a step to the side. Its plan replaces the real-time iteration's when it is solved and safe (and
+ * with sideways, costs less); otherwise the real-time iteration's stands (it passed the monitors) and
+ * the next period starts cold. Returns 1 when it replaced it. */
+static int controller_recover(hm_controller *c, unsigned long long t0, int sideways, hm_controller_output *out)
+{
+    hm_solver *s = &c->solver;
+    const hm_real tol = hm_fmax(s->params.qp_tol, HM_R(1e-6));
+    const unsigned long long t1 = ocp_nlp_now(s);
+    hm_output *r = &c->recovery_out;
+    int ok;
+    ocp_nlp_sqp_reset(s);
+    if (sideways) controller_nudge(c);
+    ocp_nlp_sqp_solve_timed(s, &c->in, r, c->params.recovery_iterations, tol, t0);
+    out->time_recovery_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t1);
+    ok = !r->stop && r->qp_status == HM_QP_SOLVED && (!sideways || r->cost < c->out.cost);
+    if (ok) {
+        c->out = *r;
+    } else {
+        ocp_nlp_sqp_reset(s);
+    }
+    return ok;
+}
+
+/* Braking to a standstill at the goal, or without one: the protective stop's braking plan, which is
+ * not a protective stop. */
+static void controller_brake(hm_controller *c)
+{
+    ocp_nlp_clear_output(&c->out);
+    ocp_nlp_protective_stop(&c->solver, &c->in, &c->out, HM_STOP_NONE);
+    c->out.stop = 0;
+    ocp_nlp_sqp_reset(&c->solver);
+}
+
+/* Progress towards the goal: the distance left must shrink by stall_distance within stall_time; a
+ * path that grows (a replanned detour) restarts the measure, not the timer; a protective stop or a
+ * new goal restarts both. Returns 1 when stalled; *slow: 1 when the robot has gone slower than half
+ * the speed it tracks for stall_time. */
+static int controller_progress(hm_controller *c, const hm_controller_input *cin, const hm_controller_goal *g,
+                               int stopped, int *slow, hm_controller_output *out)
+{
+    const hm_params *p = &c->params;
+    const int new_goal = !c->has_goal || hm_fabs(g->final[0] - c->goal_xy[0]) > HM_R(1e-6) ||
+                         hm_fabs(g->final[1] - c->goal_xy[1]) > HM_R(1e-6);
+    if (new_goal || stopped || !c->has_time || cin->time < c->time_last ||
+        cin->v >= HM_R(0.5) * c->in.goal[3])
+        c->time_brisk = cin->time;
+    *slow = cin->time - c->time_brisk > p->stall_time;
+    if (new_goal || stopped || !c->has_time || cin->time < c->time_last) {
+        c->best_left = g->left;
+        c->time_progress = cin->time;
+        c->has_recovery = 0;
+    } else if (g->left < c->best_left - p->stall_distance) {
+        c->best_left = g->left;
+        c->time_progress = cin->time;
+    } else if (g->left > c->best_left) {
+        c->best_left = g->left;
+    }
+    c->has_goal = 1;
+    c->goal_xy[0] = g->final[0];
+    c->goal_xy[1] = g->final[1];
+    c->has_time = 1;
+    c->time_last = cin->time;
+    out->time_without_progress = cin->time - c->time_progress;
+    return out->time_without_progress > p->stall_time;
+}
+
+static void controller_clear_output(hm_controller_output *out)
+{
+    out->outcome = HM_OUTCOME_FOLLOWING;
+    out->goal_reached = 0;
+    out->stalled = 0;
+    out->recovered = 0;
+    out->loop_detected = 0;
+    out->n_people = 0;
+    out->has_obstacle = 0;
+    out->distance_to_goal = HM_INF;
+    out->time_without_progress = HM_R(0.0);
+    out->time_solver_ms = HM_R(0.0);
+    out->time_recovery_ms = HM_R(0.0);
+}
+
+/* out from the solver's output c->out (the plan, the command, the stop). */
+static void controller_report(const hm_controller *c, hm_controller_output *out)
+{
+    const hm_output *o = &c->out;
+    int n, i;
+    out->command[0] = o->command[0];
+    out->command[1] = o->command[1];
+    out->u[0] = o->u0[0];
+    out->u[1] = o->u0[1];
+    out->stop = o->stop;
+    out->stop_reason = o->stop_reason;
+    out->status = o->status;
+    out->qp_status = o->qp_status;
+    out->qp_iterations = o->qp_iterations;
+    out->sqp_iterations = o->sqp_iterations;
+    out->min_human_distance = o->min_human_distance;
+    for (n = 0; n <= HM_N; n++)
+        for (i = 0; i < HM_NX; i++) out->plan[n][i] = o->x[n][i];
+    for (n = 0; n < HM_N; n++)
+        for (i = 0; i < HM_NU; i++) out->controls[n][i] = o->u[n][i];
+    for (i = 0; i < HM_NX; i++) out->ocp_goal[i] = c->in.goal[i];
+    out->has_obstacle = c->in.has_obstacle;
+    out->obstacle[0] = c->in.obstacle[0];
+    out->obstacle[1] = c->in.obstacle[1];
+    if (o->stop) out->outcome = HM_OUTCOME_STOPPED;
+}
+
+HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm_controller_output *out)
+{
+    hm_solver *s = &c->solver;
+    hm_input *in = &c->in;
+    const unsigned long long t0 = ocp_nlp_now(s);
+    const hm_real horizon = HM_R(HM_DT) * (hm_real)HM_N;
+    hm_controller_goal g;
+    unsigned long long t1;
+    int slow = 0;
+    controller_clear_output(out);
+    in->n_humans = 0;
+    in->has_obstacle = 0;
+    in->x0[0] = cin->pose[0];
+    in->x0[1] = cin->pose[1];
+    in->x0[2] = cin->pose[2];
+    in->x0[3] = cin->v;
+    if (!controller_input_ok(cin) || !monitor_check_params(&c->params)) {
+        int i;
+        const int reason = monitor_check_params(&c->params) ? HM_STOP_INVALID_INPUT : HM_STOP_INVALID_PARAMS;
+        for (i = 0; i < HM_NX; i++) in->goal[i] = in->x0[i];
+        s->params = c->params;
+        ocp_nlp_clear_output(&c->out);
+        ocp_nlp_protective_stop(s, in, &c->out, reason);
+        ocp_nlp_sqp_reset(s);
+        c->has_time = 0;
+        c->has_theta = 0;
+        controller_report(c, out);
+        out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
+        return out->outcome;
+    }
+    /* headings wind continuously for the OCP: odometry's wrap at +-pi would be a jump of 2 pi */
+    if (c->has_theta) in->x0[2] = controller_unwrap(cin->pose[2], c->theta);
+    c->theta = in->x0[2];
+    c->has_theta = 1;
+    controller_goal(cin, cin->pose, in->x0[2],
+                    c->params.lookahead > HM_R(0.0) ? c->params.lookahead : c->params.v_ref * horizon, &g);
+    if (!g.has) {
+        s->params = c->params;
+        in->goal[0] = in->x0[0];
+        in->goal[1] = in->x0[1];
+        in->goal[2] = in->x0[2];
+        in->goal[3] = HM_R(0.0);
+        controller_brake(c);
+        controller_report(c, out);
+        out->outcome = HM_OUTCOME_NO_GOAL;
+        c->has_goal = 0;
+        out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
+        return out->outcome;
+    }
+    out->distance_to_goal = g.left;
+    in->goal[0] = g.carrot[0];
+    in->goal[1] = g.carrot[1];
+    in->goal[2] = g.carrot[2];
+    controller_solver_params(c, &g);
+    if (g.to_final <= c->params.goal_tolerance) {
+        controller_brake(c);
+        controller_report(c, out);
+        out->outcome = HM_OUTCOME_GOAL_REACHED;
+        out->goal_reached = 1;
+        controller_progress(c, cin, &g, 1, &slow, out);
+        out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
+        return out->outcome;
+    }
+    controller_select_people(s, cin, in, out);
+    controller_nearest_obstacle(s, cin, c->solver.params.v_bounds[1], in);
+    t1 = ocp_nlp_now(s);
+    ocp_nlp_sqp_rti_step(s, in, &c->out);
+    out->time_solver_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t1);
+    if (!c->out.stop && c->params.recovery_iterations > 0 && controller_is_loop(&c->params, &c->out)) {
+        out->loop_detected = 1;
+        out->recovered = controller_recover(c, t0, 0, out);
+    }
+    out->stalled = controller_progress(c, cin, &g, c->out.stop, &slow, out);
+    if ((out->stalled || slow) && !out->recovered && !c->out.stop && c->params.recovery_iterations > 0 &&
+        (!c->has_recovery || cin->time - c->time_recovery >= c->params.stall_time)) {
+        c->has_recovery = 1;
+        c->time_recovery = cin->time;
+        out->recovered = controller_recover(c, t0, 1, out);
+    }
+    controller_report(c, out);
+    if (out->stalled && !out->stop) out->outcome = HM_OUTCOME_STALLED;
+    out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
+    return out->outcome;
+}
+
+HM_FUNC const char *controller_outcome_message(int outcome)
+{
+    switch (outcome) {
+        HM_OUTCOME_TABLE(HM_STATUS_CASE_ROW)
+    default:
+        return "unknown outcome";
+    }
+}

@@ -1,0 +1,21 @@
+/*
+ * controller.h: the navigation controller (controller.c), configured once, then called once per
+ * control period with odometry, a path or a goal, tracked people and obstacle points; it returns a
+ * velocity command and says what it is doing (an outcome, a stop and its reason, goal reached,
+ * stalled), never silently. Around the solver it does what a robot needs and the OCP alone does not:
+ * the goal the OCP sees (controller_goal.h), the people and the obstacle it sees
+ * (controller_people.h), the approach to the goal, the speed limit, loop and stall detection with a
+ * recovery by a bounded SQP inside the deadline, the braking at the goal.
+ */
+#ifndef CONTROLLER_H
+#define CONTROLLER_H
+#include "controller_common.h"
+
+HM_FUNC void controller_init(hm_controller *c, const hm_params *params);
+/* Forget the episode: a cold solver, no progress history; the parameters are kept. */
+HM_FUNC void controller_reset(hm_controller *c);
+/* One control period; returns out->outcome. */
+HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm_controller_output *out);
+HM_FUNC const char *controller_outcome_message(int outcome);
+
+#endif /* CONTROLLER_H */

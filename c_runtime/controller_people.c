@@ -1,0 +1,106 @@
+/*
+ * controller_people.c: the people and the obstacle the OCP sees (controller_people.h).
+ *
+ * The solver handles N_h people; a crowd has more. The hard distance rows act on people's current
+ * positions and the cost on their predictions, so the people that matter are those the robot's path
+ * comes near over the horizon: someone 3 m away walking straight at the robot matters more than
+ * someone 2 m away walking off. A track's relevance is the smallest distance between its prediction
+ * and the robot's expected path at the same node, less two standard deviations of its position when
+ * the tracker gives a covariance (an uncertain track counts as nearer).
+ */
+#include "controller_people.h"
+
+/* The robot's expected position at node n. */
+static void controller_expected(const hm_solver *s, const hm_controller_input *cin, int n, hm_real *p)
+{
+    if (s->warm) {
+        const int k = n + 1 <= HM_N ? n + 1 : HM_N;
+        p[0] = s->x[k][0];
+        p[1] = s->x[k][1];
+    } else {
+        const hm_real d = cin->v * HM_R(HM_DT) * (hm_real)n;
+        p[0] = cin->pose[0] + d * hm_cos(cin->pose[2]);
+        p[1] = cin->pose[1] + d * hm_sin(cin->pose[2]);
+    }
+}
+
+/* Largest standard deviation of a 2x2 covariance [sxx, sxy, syy] (its largest eigenvalue's root). */
+static hm_real controller_sigma(const hm_real *c)
+{
+    const hm_real mean = HM_R(0.5) * (c[0] + c[2]);
+    const hm_real half = HM_R(0.5) * (c[0] - c[2]);
+    return hm_sqrt(hm_fmax(mean + hm_sqrt(half * half + c[1] * c[1]), HM_R(0.0)));
+}
+
+HM_FUNC void controller_select_people(const hm_solver *s, const hm_controller_input *cin, hm_input *in,
+                                      hm_controller_output *out)
+{
+    hm_real score[HM_MAX_TRACKS];
+    hm_real path[HM_N + 1][2];
+    int chosen[HM_MAX_TRACKS];
+    int i, n, j, k = 0;
+    for (n = 0; n <= HM_N; n++) controller_expected(s, cin, n, path[n]);
+    for (i = 0; i < cin->n_tracks; i++) {
+        const hm_real *t = cin->tracks[i];
+        hm_real best = HM_INF;
+        for (n = 0; n <= HM_N; n++) {
+            const hm_real tau = HM_R(HM_DT) * (hm_real)n;
+            const hm_real dx = t[0] + tau * t[2] - path[n][0];
+            const hm_real dy = t[1] + tau * t[3] - path[n][1];
+            best = hm_fmin(best, dx * dx + dy * dy);
+        }
+        score[i] = hm_sqrt(best);
+        if (cin->track_has_covariance[i] == 1) score[i] -= HM_R(2.0) * controller_sigma(cin->track_covariances[i]);
+        chosen[i] = 0;
+    }
+    /* the HM_NH best, in order of relevance (a partial selection sort: N_h passes over the tracks) */
+    for (j = 0; j < HM_NH && j < cin->n_tracks; j++) {
+        int pick = -1;
+        for (i = 0; i < cin->n_tracks; i++)
+            if (!chosen[i] && (pick < 0 || score[i] < score[pick])) pick = i;
+        chosen[pick] = 1;
+        out->people_index[k] = pick;
+        out->people_ids[k] = cin->track_ids[pick];
+        k++;
+    }
+    in->n_humans = k;
+    out->n_people = k;
+    for (j = 0; j < k; j++) {
+        const hm_real *t = cin->tracks[out->people_index[j]];
+        in->humans_now[j][0] = t[0];
+        in->humans_now[j][1] = t[1];
+        for (n = 0; n <= HM_N; n++) {
+            const hm_real tau = HM_R(HM_DT) * (hm_real)n;
+            in->humans_pred[n][j][0] = out->predictions[n][j][0] = t[0] + tau * t[2];
+            in->humans_pred[n][j][1] = out->predictions[n][j][1] = t[1] + tau * t[3];
+        }
+    }
+}
+
+HM_FUNC void controller_nearest_obstacle(const hm_solver *s, const hm_controller_input *cin, hm_real speed,
+                                         hm_input *in)
+{
+    hm_real path[HM_N + 2][2];
+    hm_real best = HM_INF;
+    int i, n, pick = -1;
+    path[0][0] = cin->pose[0];
+    path[0][1] = cin->pose[1];
+    for (n = 0; n <= HM_N; n++) controller_expected(s, cin, n, path[n + 1]);
+    for (i = 0; i < cin->n_obstacles; i++) {
+        for (n = 0; n <= HM_N + 1; n++) {
+            const hm_real dx = cin->obstacles[i][0] - path[n][0];
+            const hm_real dy = cin->obstacles[i][1] - path[n][1];
+            /* how soon the robot could be at the point: reaching node n, then going straight to it */
+            const hm_real soon = hm_sqrt(dx * dx + dy * dy) + speed * HM_R(HM_DT) * (hm_real)(n > 0 ? n - 1 : 0);
+            if (soon < best) {
+                best = soon;
+                pick = i;
+            }
+        }
+    }
+    in->has_obstacle = pick >= 0;
+    if (pick >= 0) {
+        in->obstacle[0] = cin->obstacles[pick][0];
+        in->obstacle[1] = cin->obstacles[pick][1];
+    }
+}

@@ -1,0 +1,25 @@
+/*
+ * controller_types.h: the sized type of the navigation controller around the solver, instantiated
+ * once per solver like ocp_nlp_types.h (no include guard; the same HM_NS / HM_REAL / HM_N / HM_NG
+ * contract). Included by a generated public header after ocp_nlp_types.h: the controller embeds a
+ * solver, its input and output, and what it remembers between control periods.
+ */
+typedef struct HM_NS(controller) {
+    HM_NS(params) params;         /* the caller's parameters: the solver's and the controller's */
+    HM_NS(solver) solver;         /* its parameters are derived from params in every period */
+    HM_NS(input) in;              /* the solver's input, built from the controller's */
+    HM_NS(output) out;            /* the real-time iteration's output */
+    HM_NS(output) recovery_out;   /* a recovery SQP's output */
+    /* Progress towards the goal (the stall timer). */
+    int has_goal;                 /* 1: goal_xy is the final goal of the last period */
+    HM_REAL goal_xy[2];
+    HM_REAL best_left;            /* the smallest distance left since the timer started */
+    HM_REAL time_progress;        /* when the distance left last shrank by stall_distance */
+    HM_REAL time_brisk;           /* when the robot last went at half the speed it tracks, or stopped */
+    int has_time;
+    HM_REAL time_last;
+    int has_recovery;             /* 1: time_recovery holds the last stall recovery */
+    HM_REAL time_recovery;
+    int has_theta;                /* 1: theta is the last period's heading, unwrapped */
+    HM_REAL theta;
+} HM_NS(controller);

@@ -1,0 +1,158 @@
+"""The navigation controller of a loaded package: ``humanmpc.load(DIR).controller()``.
+
+A thin face over the generated C controller (``<name>_controller_step``): per control period it
+copies the robot's odometry, its path or goal, the tracked people and the obstacle points into the C
+input struct, makes one C call and returns the output as a :class:`ControllerResult`. Everything the
+controller decides (the carrot, the people it hands the OCP, the approach, the speed limit, loop and
+stall recovery, braking at the goal) is the C's; firmware and the ROS node run the same code.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .codegen.params import Param
+from .results import ControllerResult, record_dtype
+from .runtime_params import RuntimeParams
+
+
+def _points(what: str, value: ArrayLike | None, columns: int, capacity: int, key: str) -> np.ndarray:
+    """value as an (n, columns) float64 array with n <= capacity (an empty one for None)."""
+    if value is None:
+        return np.zeros((0, columns))
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] != columns:
+        raise ValueError(f"{what} must have shape (n, {columns}), got {arr.shape}")
+    if arr.shape[0] > capacity:
+        raise ValueError(f"{what} holds {arr.shape[0]} rows, but this controller takes at most {capacity} "
+                         f"(the spec's {key}): regenerate with a larger {key}, or thin them out")
+    return arr
+
+
+class Controller:
+    """A generated navigation controller (C memory owned by this object)."""
+
+    def __init__(self, name: str, dims: Any, ffi: Any, lib: Any, params_table: tuple[Param, ...]) -> None:
+        fn = lambda suffix: getattr(lib, f"{name}_{suffix}")  # noqa: E731
+        self.name = name
+        self.dims = dims
+        self._ffi = ffi
+        self.memsize = int(fn("controller_memsize")())
+        sizes = ffi.new("size_t[2]")
+        fn("controller_struct_sizes")(sizes + 0, sizes + 1)
+        declared = [ffi.sizeof(f"{name}_controller_input"), ffi.sizeof(f"{name}_controller_output")]
+        if list(sizes) != declared:
+            raise ValueError(f"{name}_cffi.h declares the controller's input/output as {declared} bytes, the "
+                             f"library was compiled with {list(sizes)}: regenerate and rebuild the package")
+        self._mem = ffi.new("char[]", self.memsize)
+        self._ctl = fn("controller_create")(self._mem)
+        self._c_step = fn("controller_step")
+        self._c_reset = fn("controller_reset")
+        self._lock = threading.Lock()
+        self._params = RuntimeParams(ffi, lib, name, fn("controller_params")(self._ctl), params_table, self._lock)
+        self._in = ffi.new(f"{name}_controller_input *")
+        self._out = ffi.new(f"{name}_controller_output *")
+        self._out_buffer = ffi.buffer(self._out)
+        self._out_dtype = record_dtype(ffi, f"{name}_controller_output")
+        self.dtype = np.dtype(np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64)
+        c = self._in
+        self.max_tracks = len(c.track_ids)
+        self.max_path_points = len(c.path)
+        self.max_obstacle_points = len(c.obstacles)
+
+        def view(cdata: Any, shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+            return np.frombuffer(ffi.buffer(cdata), dtype=dtype).reshape(shape)
+
+        rt = self.dtype
+        self._pose = view(c.pose, (3,), rt)
+        self._goal = view(c.goal, (3,), rt)
+        self._path = view(c.path, (self.max_path_points, 2), rt)
+        self._tracks = view(c.tracks, (self.max_tracks, 4), rt)
+        self._ids = view(c.track_ids, (self.max_tracks,), np.int32)
+        self._has_cov = view(c.track_has_covariance, (self.max_tracks,), np.int32)
+        self._cov = view(c.track_covariances, (self.max_tracks, 3), rt)
+        self._obstacles = view(c.obstacles, (self.max_obstacle_points, 2), rt)
+
+    # -- parameters ---------------------------------------------------------------------------
+    @property
+    def params(self) -> dict[str, Any]:
+        """The runtime parameters now in force (the solver's and the controller's)."""
+        return self._params.values
+
+    def set_params(self, **values: Any) -> None:
+        """Change runtime parameters (checked by their rules; on any error nothing changes)."""
+        self._params.set(**values)
+
+    def reset(self) -> None:
+        """A new episode: a cold solver and no progress history; the parameters are kept."""
+        with self._lock:
+            self._c_reset(self._ctl)
+
+    # -- one control period -------------------------------------------------------------------
+    def step(self, t: float, pose: ArrayLike, v: float, omega: float = 0.0, *, path: ArrayLike | None = None,
+             goal: ArrayLike | None = None, people: ArrayLike | None = None, ids: ArrayLike | None = None,
+             covariances: ArrayLike | None = None, obstacles: ArrayLike | None = None) -> ControllerResult:
+        """One control period.
+
+        t: time stamp [s]; pose: (x, y, theta) [m, m, rad]; v [m/s], omega [rad/s]: odometry;
+        path: (n, 2) waypoints to the goal, and/or goal: (x, y, theta), the final pose (alone: a straight
+        path; with a path: its final heading); people: (k, 4) tracks [x, y, vx, vy] [m, m/s] with
+        optional ids (k,) (default 0..k-1) and covariances (k, 3) [sxx, sxy, syy] [m^2] (NaN rows: none);
+        obstacles: (m, 2) occupied points [m]. All in one world frame.
+        """
+        pose_a = np.asarray(pose, dtype=np.float64)
+        if pose_a.shape != (3,):
+            raise ValueError(f"pose must be (x, y, theta), got shape {pose_a.shape}")
+        P = _points("path", path, 2, self.max_path_points, "controller.max_path_points")
+        Q = _points("people", people, 4, self.max_tracks, "controller.max_tracks")
+        O = _points("obstacles", obstacles, 2, self.max_obstacle_points, "controller.max_obstacle_points")
+        k = Q.shape[0]
+        if ids is None:
+            id_a = np.arange(k, dtype=np.int64)
+        else:
+            id_a = np.asarray(ids)
+            if id_a.shape != (k,) or not np.issubdtype(id_a.dtype, np.integer):
+                raise ValueError(f"ids must be {k} integers (one per person), got {id_a!r}")
+            if k and (id_a.min() < -2**31 or id_a.max() >= 2**31):
+                raise ValueError("ids must fit in 32 bits")
+        cov = None
+        if covariances is not None:
+            cov = np.asarray(covariances, dtype=np.float64)
+            if cov.shape != (k, 3):
+                raise ValueError(f"covariances must have shape ({k}, 3) = [sxx, sxy, syy] per person, got {cov.shape}")
+        if goal is not None:
+            goal_a = np.asarray(goal, dtype=np.float64)
+            if goal_a.shape != (3,):
+                raise ValueError(f"goal must be (x, y, theta), got shape {goal_a.shape}")
+        with self._lock:
+            c = self._in
+            c.time = float(t)
+            self._pose[...] = pose_a
+            c.v = float(v)
+            c.omega = float(omega)
+            c.n_path = P.shape[0]
+            self._path[: P.shape[0]] = P
+            c.has_goal = int(goal is not None)
+            if goal is not None:
+                self._goal[...] = goal_a
+            c.n_tracks = k
+            self._tracks[:k] = Q
+            self._ids[:k] = id_a
+            if cov is None:
+                self._has_cov[:k] = 0
+            else:
+                given = np.all(np.isfinite(cov), axis=1)
+                self._has_cov[:k] = given
+                self._cov[:k] = np.where(given[:, None], cov, 0.0)
+            c.n_obstacles = O.shape[0]
+            self._obstacles[: O.shape[0]] = O
+            self._c_step(self._ctl, self._in, self._out)
+            return ControllerResult(np.ndarray((), self._out_dtype, self._out_buffer[:]))
+
+    def __repr__(self) -> str:
+        return (f"<humanmpc.Controller {self.name!r} N={self.dims.N} nh={self.dims.nh} tracks<={self.max_tracks} "
+                f"path<={self.max_path_points} obstacles<={self.max_obstacle_points}>")
