@@ -106,10 +106,10 @@ def test_simulate_command_runs_and_writes_the_plot(tmp_path: Path, capsys: pytes
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["simulate", "--scenario", "mall", "--planner", "dwb"], "valid scenarios: circle_crossing"),
+        (["simulate", "--scenario", "mall", "--planner", "dwb"], "valid scenarios: biwi_eth, biwi_hotel, circle"),
         (["simulate", "--scenario", "corridor", "--planner", "teleport"], "valid planners: dwb"),
         (["evaluate", "--planners", "teleport"], "valid planners: dwb"),
-        (["evaluate", "--scenarios", "mall"], "valid scenarios: circle_crossing"),
+        (["evaluate", "--scenarios", "mall"], "valid scenarios: biwi_eth, biwi_hotel, circle"),
     ],
 )
 def test_commands_reject_unknown_names_listing_valid_ones(

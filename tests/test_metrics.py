@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from humanmpc.eval.episode import EpisodeLog
-from humanmpc.eval.metrics import compute_metrics, mean_jerk, rising_edges
+from humanmpc.eval.metrics import compute_metrics, freezing, mean_jerk, rising_edges
 from humanmpc.sim.robot import RobotModel
 from humanmpc.sim.world import Circle, World
 
@@ -18,6 +18,8 @@ def make_log(
     humans: np.ndarray,
     *,
     theta: np.ndarray | None = None,
+    speed: np.ndarray | float = 0.0,
+    present: np.ndarray | None = None,
     world: World | None = None,
     goal: tuple[float, float] = (10.0, 0.0),
     reached: bool = True,
@@ -26,7 +28,7 @@ def make_log(
 ) -> EpisodeLog:
     n = xy.shape[0]
     th = np.zeros(n) if theta is None else theta
-    states = np.column_stack([xy, th, np.zeros(n)])
+    states = np.column_stack([xy, th, np.broadcast_to(speed, (n,))])
     T = n - 1
     return EpisodeLog(
         scenario="hand", seed=0, planner="test", dt=DT, world=world or World(),
@@ -36,7 +38,7 @@ def make_log(
         stops=np.zeros(T, dtype=bool) if stops is None else stops,
         reasons=[None] * T if reasons is None else reasons,
         solve_ms=np.linspace(1.0, 2.0, T), plans=[None] * T,
-        reached_goal=reached, ended_by="goal" if reached else "time_limit",
+        reached_goal=reached, ended_by="goal" if reached else "time_limit", present_mask=present,
     )
 
 
@@ -124,3 +126,126 @@ def test_timeout_and_planner_time_statistics() -> None:
 
 def test_rising_edges_include_a_series_that_starts_on() -> None:
     np.testing.assert_array_equal(rising_edges(np.array([1, 1, 0, 1, 0, 0, 1], dtype=bool)), [0, 3, 6])
+
+
+# Contact attribution. Contact: centre distance < 0.2 + 0.25 = 0.45 m. The robot's fault: it moves
+# faster than 0.05 m/s with the person strictly within +-90 degrees of its heading.
+
+
+def test_driving_into_a_standing_person_is_the_robots_fault_until_it_is_past_them() -> None:
+    # 1 m/s along x past a person standing at (5.05, 0.1): in contact while |x - 5.05| < sqrt(0.45^2 - 0.1^2)
+    # = 0.4387, x in {4.7, ..., 5.4} (8 samples); the person is ahead for x < 5.05 (4 samples), behind after.
+    m = compute_metrics(make_log(straight(), np.tile([[5.05, 0.1]], (101, 1, 1)), speed=1.0))
+    assert (m.robot_fault_contacts, m.person_fault_contacts) == (1, 0)
+    assert (m.robot_fault_steps, m.person_fault_steps) == (4, 4)
+
+
+def test_a_person_walking_into_a_standing_robot_is_the_persons_fault() -> None:
+    # the robot stands at the origin facing the person, who walks at it at 1 m/s from x = 2 and stops at 0.3
+    xh = np.maximum(2.0 - 0.1 * np.arange(31), 0.3)
+    humans = np.column_stack([xh, np.zeros(31)])[:, None, :]
+    m = compute_metrics(make_log(np.zeros((31, 2)), humans, speed=0.0))
+    # in contact from x = 0.4 (sample 16) to the end (sample 30): 15 samples
+    assert (m.robot_fault_contacts, m.person_fault_contacts) == (0, 1)
+    assert (m.robot_fault_steps, m.person_fault_steps) == (0, 15)
+
+
+def test_a_person_catching_up_from_behind_a_moving_robot_is_the_persons_fault() -> None:
+    # robot at 0.2 m/s (x = 0.02 i), person behind at 1 m/s (x = -1 + 0.1 i): gap 1 - 0.08 i, in contact
+    # for 0.55 < 0.08 i, i = 7..12 (the log ends before they would pass through)
+    i = np.arange(13)
+    xy = np.column_stack([0.02 * i, np.zeros(13)])
+    humans = np.column_stack([-1.0 + 0.1 * i, np.zeros(13)])[:, None, :]
+    m = compute_metrics(make_log(xy, humans, speed=0.2))
+    assert (m.robot_fault_contacts, m.person_fault_contacts) == (0, 1)
+    assert (m.robot_fault_steps, m.person_fault_steps) == (0, 6)
+
+
+@pytest.mark.parametrize(("speed", "robot_fault"), [(0.04, False), (0.06, True)])
+def test_the_robot_is_at_fault_only_above_the_moving_speed(speed: float, robot_fault: bool) -> None:
+    # a person 0.3 m ahead of a robot that creeps at `speed` (positions held: only the speed matters here)
+    m = compute_metrics(make_log(np.zeros((5, 2)), np.tile([[0.3, 0.0]], (5, 1, 1)), speed=speed))
+    assert (m.robot_fault_contacts, m.person_fault_contacts) == ((1, 0) if robot_fault else (0, 1))
+    assert (m.robot_fault_steps, m.person_fault_steps) == ((5, 0) if robot_fault else (0, 5))
+
+
+def test_a_person_exactly_beside_the_robot_is_not_ahead_of_it() -> None:
+    # 90 degrees off the heading is outside the strict +-90 degrees
+    m = compute_metrics(make_log(np.zeros((3, 2)), np.tile([[0.0, 0.3]], (3, 1, 1)), speed=1.0))
+    assert (m.robot_fault_contacts, m.person_fault_contacts, m.person_fault_steps) == (0, 1, 3)
+
+
+def test_touching_two_people_at_once_is_two_events_and_one_collision() -> None:
+    humans = np.tile([[[5.05, 0.1], [5.05, -0.1]]], (101, 1, 1))
+    m = compute_metrics(make_log(straight(), humans, speed=1.0))
+    assert m.human_collisions == 1
+    assert (m.robot_fault_contacts, m.person_fault_contacts) == (2, 0)
+    # a sample counts once: the robot's fault if it is towards anyone it touches
+    assert (m.robot_fault_steps, m.person_fault_steps) == (4, 4)
+
+
+def test_absent_people_count_in_no_metric() -> None:
+    # a person stands on the path at x = 5.05 but is only there from sample 60 on (robot at x = 6.0)
+    humans = np.tile([[5.05, 0.1]], (101, 1, 1))
+    present = np.zeros((101, 1), dtype=bool)
+    present[60:] = True
+    humans[~present] = np.nan
+    m = compute_metrics(make_log(straight(), humans, speed=1.0, present=present))
+    assert m.collisions == 0 and m.robot_fault_contacts == 0 and m.person_fault_steps == 0 and m.success
+    assert m.min_human_distance == pytest.approx(np.hypot(0.95, 0.1))
+    # d < 1.0 m: x - 5.05 < sqrt(1 - 0.01) = 0.995, x in {6.0} only
+    assert m.time_within_dth == pytest.approx(0.1)
+
+
+def test_a_log_with_absent_people_needs_their_mask() -> None:
+    humans = np.full((101, 1, 2), np.nan)
+    with pytest.raises(ValueError, match="present_mask"):
+        make_log(straight(), humans)
+    with pytest.raises(ValueError, match="present has a non-finite position"):
+        make_log(straight(), humans, present=np.ones((101, 1), dtype=bool))
+
+
+# Freezing: progress is coming 0.1 m closer to the goal than at the last progress; a stretch without it
+# longer than 5 s is a freezing event.
+
+
+def _stop_and_go(stop_from: int, go_at: int, n: int = 201) -> np.ndarray:
+    """1.3 m/s along x (0.13 m per sample: every sample is progress), standing from sample stop_from on
+    and moving again at sample go_at."""
+    moved = np.concatenate([np.arange(stop_from + 1), np.full(go_at - stop_from - 1, stop_from),
+                            stop_from + 1 + np.arange(n - go_at)])
+    return np.column_stack([0.13 * moved, np.zeros(n)])
+
+
+def test_standing_for_more_than_five_seconds_is_one_freezing_event() -> None:
+    xy = _stop_and_go(30, 96)  # last progress at 3.0 s, the next at 9.6 s
+    m = compute_metrics(make_log(xy, np.zeros((201, 0, 2)), goal=(40.0, 0.0), reached=False))
+    assert m.freezing_events == 1 and m.freezing_time == pytest.approx(6.6)
+
+
+@pytest.mark.parametrize(("go_at", "events", "time"), [(79, 0, 0.0), (81, 1, 5.1)])
+def test_freezing_needs_more_than_five_seconds(go_at: int, events: int, time: float) -> None:
+    xy = _stop_and_go(30, go_at)  # without progress for 4.9 s, then 5.1 s
+    m = compute_metrics(make_log(xy, np.zeros((201, 0, 2)), goal=(40.0, 0.0), reached=False))
+    assert (m.freezing_events, m.freezing_time) == (events, pytest.approx(time))
+
+
+def test_creeping_towards_the_goal_is_not_progress() -> None:
+    # 0.015 m/s: 0.1 m closer only at samples 67 (0.1005 m) and 134 (0.201 m); the stretches 0-67, 67-134 and
+    # 134-200 (to the end) last 6.7, 6.7 and 6.6 s
+    xy = np.column_stack([0.0015 * np.arange(201), np.zeros(201)])
+    assert freezing(DT * np.arange(201), xy, np.array([10.0, 0.0])) == (3, pytest.approx(20.0))
+
+
+def test_moving_away_from_the_goal_is_not_progress() -> None:
+    # 3 s towards the goal at 1 m/s (to x = 3.0), 6 s away from it (to x = -3.0), then back at 1.3 m/s: no
+    # progress from 3.0 s until x >= 3.1, 47 samples after the turn (x = 3.11): at 9.0 + 4.7 = 13.7 s
+    x = np.concatenate([0.1 * np.arange(31), 3.0 - 0.1 * np.arange(1, 61), -3.0 + 0.13 * np.arange(1, 71)])
+    xy = np.column_stack([x, np.zeros_like(x)])
+    events, time = freezing(DT * np.arange(x.size), xy, np.array([20.0, 0.0]))
+    assert events == 1 and time == pytest.approx(10.7)
+
+
+def test_a_run_that_never_stops_does_not_freeze() -> None:
+    m = compute_metrics(make_log(straight(), np.zeros((101, 0, 2)), speed=1.0))
+    assert m.freezing_events == 0 and m.freezing_time == 0.0

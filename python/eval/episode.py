@@ -11,6 +11,13 @@ Per step (period ``dt``, 0.1 s by default):
    the social force model as an agent at its state at the start of the period;
 5. log everything the metrics and plots need.
 
+The people present may change within an episode (recorded crowds: people enter and leave as
+recorded). The log keeps everyone who was ever present, in the order of their ids: ``humans``
+(T + 1, K, 2) holds NaN where a person is absent and ``present`` (T + 1, K) says who is there;
+metrics and figures use the mask (the NaN makes any use that forgets it visible, where a
+placeholder position would silently count). The predictor is given the ids, so a person's
+velocity is estimated from that person's own observations.
+
 The episode ends when the robot's centre is within the scenario's ``goal_tolerance`` of the
 goal position, or at the time limit. Collisions do **not** end it by default (the robot and
 the people carry on, the metrics count every contact event and the time spent in contact, and
@@ -26,7 +33,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..planners.interface import Observation, Planner
-from ..sim.crowd import Crowd
 from ..sim.predict import ConstantVelocityPredictor, Predictor
 from ..sim.robot import RobotModel, step, velocity_vector
 from ..sim.scenarios import Scenario
@@ -69,7 +75,7 @@ class EpisodeLog:
     time_limit: float
     times: FloatArray  # (T + 1,)
     states: FloatArray  # (T + 1, 4)
-    humans: FloatArray  # (T + 1, k, 2)
+    humans: FloatArray  # (T + 1, K, 2), NaN where absent; K: everyone present at some sample
     controls: FloatArray  # (T, 2)
     obstacle_points: FloatArray  # (T, 2)
     stops: NDArray[np.bool_]  # (T,)
@@ -78,13 +84,52 @@ class EpisodeLog:
     plans: list[FloatArray | None]  # predicted robot paths, if kept
     reached_goal: bool
     ended_by: str  # "goal", "time_limit" or "collision"
+    # (T + 1, K): who is present at each sample; None: everyone at every sample (a fixed crowd)
+    present_mask: NDArray[np.bool_] | None = None
+    human_ids: NDArray[np.int64] | None = None  # (K,): the crowd's id of each column; None: 0..K-1
+
+    def __post_init__(self) -> None:
+        shape = self.humans.shape[:2]
+        if self.humans.ndim != 3 or self.humans.shape[2] != 2:
+            raise ValueError(f"EpisodeLog: humans must have shape (T + 1, K, 2), got {self.humans.shape}")
+        if self.present_mask is not None:
+            if self.present_mask.shape != shape:
+                raise ValueError(f"EpisodeLog: present_mask must have shape {shape}, got {self.present_mask.shape}")
+            if not np.all(np.isfinite(self.humans[self.present_mask])):
+                raise ValueError("EpisodeLog: a person marked present has a non-finite position")
+        elif not np.all(np.isfinite(self.humans)):
+            raise ValueError("EpisodeLog: humans has non-finite positions; give present_mask for people who are absent")
+        if self.human_ids is not None and self.human_ids.shape != (shape[1],):
+            raise ValueError(f"EpisodeLog: human_ids must have shape ({shape[1]},), got {self.human_ids.shape}")
 
     @property
     def steps(self) -> int:
         return int(self.controls.shape[0])
 
+    @property
+    def present(self) -> NDArray[np.bool_]:
+        """(T + 1, K): True where person k is present at sample t."""
+        if self.present_mask is None:
+            return np.ones(self.humans.shape[:2], dtype=bool)
+        return self.present_mask
+
+
+def _stack_people(ids: list[NDArray[np.int64]], positions: list[FloatArray]) -> tuple[
+    FloatArray, NDArray[np.bool_], NDArray[np.int64]
+]:
+    """Per-sample (ids, positions) as (T + 1, K, 2) with NaN where absent, the mask, the ids."""
+    everyone = np.unique(np.concatenate(ids)) if ids else np.zeros(0, dtype=np.int64)
+    humans = np.full((len(ids), everyone.size, 2), np.nan)
+    present = np.zeros((len(ids), everyone.size), dtype=bool)
+    for t, (who, pos) in enumerate(zip(ids, positions, strict=True)):
+        col = np.searchsorted(everyone, who)
+        humans[t, col] = pos
+        present[t, col] = True
+    return humans, present, everyone.astype(np.int64)
+
 
 def _in_contact(world: World, robot: RobotModel, x: FloatArray, humans: FloatArray) -> bool:
+    """Contact of the robot at ``x`` with a person present (``humans`` (k, 2)) or an obstacle."""
     if humans.shape[0] and np.min(np.linalg.norm(humans - x[:2], axis=1)) < robot.radius + robot.human_radius:
         return True
     return bool(world.signed_distance(x[:2]) < robot.radius)
@@ -101,11 +146,11 @@ def run_episode(
     pred = predictor or ConstantVelocityPredictor(cfg.horizon, cfg.dt)
     pred.reset()
     planner.reset()
-    crowd = Crowd(scenario.crowd, scenario.world, cfg.social_force)
+    crowd = scenario.start_crowd(cfg.social_force)
     world, robot, goal = scenario.world, cfg.robot, np.asarray(scenario.goal, dtype=float)
     x = np.asarray(scenario.robot_start, dtype=float).copy()
     t = 0.0
-    times, states, humans = [t], [x.copy()], [crowd.positions]
+    times, states, humans, ids = [t], [x.copy()], [crowd.positions], [crowd.ids]
     controls: list[FloatArray] = []
     obstacle_points: list[FloatArray] = []
     stops: list[bool] = []
@@ -115,8 +160,8 @@ def run_episode(
     n_steps = round(scenario.time_limit / cfg.dt)
     ended_by = "time_limit"
     for _ in range(n_steps):
-        humans_now = crowd.positions
-        humans_pred = pred.observe(t, humans_now)
+        humans_now = humans[-1].copy()
+        humans_pred = pred.observe(t, humans_now, ids[-1])
         obstacle = world.obstacle_parameter(x[:2])
         obs = Observation(t, x.copy(), goal.copy(), humans_now, humans_pred, obstacle, world, cfg.dt, robot)
         t0 = time.perf_counter()
@@ -134,13 +179,15 @@ def run_episode(
         times.append(t)
         states.append(x.copy())
         humans.append(crowd.positions)
+        ids.append(crowd.ids)
         if np.linalg.norm(x[:2] - goal[:2]) <= scenario.goal_tolerance:
             ended_by = "goal"
             break
         if cfg.stop_on_collision and _in_contact(world, robot, x, humans[-1]):
             ended_by = "collision"
             break
-    k = scenario.crowd.size
+    people, present, human_ids = _stack_people(ids, humans)
+    everyone_always = bool(np.all(present))
     return EpisodeLog(
         scenario=scenario.name,
         seed=scenario.seed,
@@ -153,7 +200,7 @@ def run_episode(
         time_limit=scenario.time_limit,
         times=np.array(times),
         states=np.array(states),
-        humans=np.array(humans).reshape(len(times), k, 2),
+        humans=people,
         controls=np.array(controls).reshape(-1, 2),
         obstacle_points=np.array(obstacle_points).reshape(-1, 2),
         stops=np.array(stops, dtype=bool),
@@ -162,4 +209,6 @@ def run_episode(
         plans=plans,
         reached_goal=ended_by == "goal",
         ended_by=ended_by,
+        present_mask=None if everyone_always else present,
+        human_ids=human_ids,
     )

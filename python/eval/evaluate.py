@@ -5,6 +5,9 @@ Writes to ``out_dir``:
 * ``runs.csv``: one row of :class:`~humanmpc.eval.metrics.EpisodeMetrics` per (scenario, planner, seed);
 * ``summary.csv`` and ``summary.md``: mean and standard deviation per scenario and planner
   (rates for success / timeout, sums are not used: every number is a per-run mean);
+* ``safety.md``: per scenario and planner, totals over the runs: goals reached, contacts by
+  fault (events and steps), the median of the runs' minimum distances, the time in protective
+  stop and freezing (:func:`safety_table`);
 * ``figures/<scenario>_seed<first seed>.png``: the paths of every planner on the first seed.
 """
 
@@ -21,15 +24,16 @@ import numpy as np
 from tqdm import tqdm
 
 from ..planners.registry import make_planner, planner_names
-from ..sim.scenarios import SCENARIOS, make_scenario
+from ..sim.scenarios import SCENARIOS, check_seeds, make_scenario
 from .episode import EpisodeConfig, EpisodeLog, run_episode
 from .metrics import compute_metrics
 from .plots import plot_episodes
 
 SUMMARY_COLUMNS = [
-    "success", "collisions", "timeout", "time_to_goal", "path_length", "min_human_distance",
-    "time_within_dth", "time_intimate", "time_personal", "protective_stops", "path_irregularity",
-    "mean_jerk", "planner_ms_mean", "planner_ms_p99", "planner_ms_max",
+    "success", "collisions", "robot_fault_contacts", "person_fault_contacts", "timeout", "time_to_goal",
+    "path_length", "min_human_distance", "time_within_dth", "time_intimate", "time_personal", "protective_stops",
+    "stop_time", "freezing_time", "path_irregularity", "mean_jerk", "planner_ms_mean", "planner_ms_p99",
+    "planner_ms_max",
 ]
 
 
@@ -57,11 +61,14 @@ def _run_job_plain(job: Job) -> tuple[Row, EpisodeLog | None]:
     return run_job(job)
 
 
-def validate_names(scenarios: Sequence[str], planners: Sequence[str]) -> None:
-    """``ValueError`` naming the valid choices for any unknown scenario or planner."""
+def validate_names(scenarios: Sequence[str], planners: Sequence[str], seeds: Sequence[int] = ()) -> None:
+    """``ValueError`` naming the valid choices for any unknown scenario or planner, or for a seed
+    that a scenario does not have (a recorded scene has one seed per crossing)."""
     bad_s = [s for s in scenarios if s not in SCENARIOS]
     if bad_s:
         raise ValueError(f"unknown scenario(s) {', '.join(bad_s)}; valid scenarios: {', '.join(sorted(SCENARIOS))}")
+    for scenario in scenarios:
+        check_seeds(scenario, seeds)
     valid_p = planner_names()
     bad_p = [p for p in planners if p not in valid_p]
     if bad_p:
@@ -107,6 +114,41 @@ def markdown_table(summary: Sequence[Row]) -> str:
     return "\n".join(lines) + "\n"
 
 
+SAFETY_HEADER = (
+    "| scenario | planner | runs | goals reached | robot-fault contacts: events / steps | runs with a robot-fault "
+    "contact | person-fault contacts: events / steps | min distance, median of runs [m] | time in protective stop, "
+    "mean [s] | freezing: events / mean time [s] |"
+)
+
+
+def safety_table(rows: Sequence[Row]) -> str:
+    """Per (scenario, planner), over its runs: goals reached, contact events and steps (samples,
+    0.1 s each) by fault, runs with a robot-fault contact, the median of the runs' minimum
+    centre distances to a person, the mean time in protective stop per run, freezing events
+    (total) and the mean freezing time per run. Markdown."""
+    keys = sorted({(str(r["scenario"]), str(r["planner"])) for r in rows})
+    lines = [SAFETY_HEADER, "|" + "---|" * SAFETY_HEADER.count(" | ") + "---|"]
+    for scen, plan in keys:
+        group = [r for r in rows if r["scenario"] == scen and r["planner"] == plan]
+
+        def total(col: str, group: list[Row] = group) -> int:
+            return int(sum(int(r[col]) for r in group))
+
+        def mean(col: str, group: list[Row] = group) -> float:
+            return float(np.mean([float(r[col]) for r in group]))
+
+        cells = [
+            scen, plan, str(len(group)), f"{total('reached_goal')} / {len(group)}",
+            f"{total('robot_fault_contacts')} / {total('robot_fault_steps')}",
+            str(sum(1 for r in group if int(r["robot_fault_contacts"]) or int(r["robot_fault_steps"]))),
+            f"{total('person_fault_contacts')} / {total('person_fault_steps')}",
+            f"{float(np.median([float(r['min_human_distance']) for r in group])):.2f}",
+            f"{mean('stop_time'):.1f}", f"{total('freezing_events')} / {mean('freezing_time'):.1f}",
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
 @dataclass(frozen=True)
 class EvaluationResult:
     rows: list[Row]
@@ -125,7 +167,7 @@ def evaluate(
     progress: bool = True,
 ) -> EvaluationResult:
     """Run every combination, write the tables (and figures) and return them."""
-    validate_names(scenarios, planners)
+    validate_names(scenarios, planners, seeds)
     if not seeds:
         raise ValueError("evaluate needs at least one seed")
     out = Path(out_dir)
@@ -155,6 +197,7 @@ def evaluate(
     write_csv(rows, out / "runs.csv")
     write_csv(summary, out / "summary.csv")
     (out / "summary.md").write_text(markdown_table(summary))
+    (out / "safety.md").write_text(safety_table(rows))
     written: list[Path] = []
     if figures:
         logs = [log for _, log in results if log is not None]

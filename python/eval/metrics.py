@@ -4,13 +4,32 @@ Definitions (distances to humans are centre-to-centre, robot centre to human cen
 
 * collision with a human: centre distance < robot radius + human radius; with an obstacle:
   signed distance of the robot centre < robot radius. A collision *event* is an entry into
-  contact (a rising edge over the logged samples; contact at the first sample counts);
+  contact (a rising edge over the logged samples; contact at the first sample counts). Only
+  the people present at a sample count (the log's ``present`` mask; recorded crowds change);
+* whose fault a contact with a human is: the robot's when, at that sample, it moves (|v| >
+  0.05 m/s) with the person strictly within +-90 degrees of its direction of travel (its
+  heading; it never reverses with the evaluation's limits, v >= 0), i.e. its velocity has a
+  positive component towards the person; otherwise the person's (they walked into a robot that
+  stood, or that moved away from or past them). *Events* are counted per person (one person's
+  entry into contact; two people touched at once are two events) and attributed at their first
+  sample; ``human_collisions`` counts entries into contact with anyone, so it is at most the sum
+  of the two. *Steps* are logged samples (one per control period, the final state included) in
+  contact with someone: the robot's fault if it is at fault towards anyone it touches, else
+  the people's; the two step counts add up to the samples in contact with a human;
+* freezing (no progress towards the goal for more than 5 s): the distance d from the robot's
+  centre to the goal position is tracked against a reference, at first d at the start; *progress*
+  is a sample at which d is at least 0.1 m below the reference, which then becomes that d (so
+  progress means coming 0.1 m closer to the goal than the robot has been since its last
+  progress: standing, creeping below 0.1 m per 5 s, circling or backing off are not progress).
+  Every stretch between consecutive progress samples (and from the last one to the episode's
+  end) that lasts more than 5 s is a freezing event; ``freezing_time`` is their total length;
 * success: the goal was reached within the time limit with no collision event at all;
 * time inside a distance band: ``dt`` times the number of control intervals whose starting
   sample has the nearest human in that band; ``intimate`` is d < 0.45 m and ``personal`` is
   0.45 m <= d < 1.2 m (Hall's proxemic zones), ``within_dth`` is d < d_th (1.0 m);
 * protective stops: events (rising edges of the planner's ``stop`` flag), counted per reason
-  of the first step of each event, and the total time spent stopping;
+  of the first step of each event, and the time spent in protective stop (``stop_time``: dt
+  times the control steps whose planner result was a stop);
 * path irregularity (SocNavBench, after Guzzi et al. 2013): the sum over the logged samples of
   the absolute angle between the robot's heading and the direction to the goal, divided by
   the path length (rad/m; it depends on the sampling period, 0.1 s here; a sample exactly on
@@ -37,6 +56,9 @@ FloatArray = NDArray[np.float64]
 INTIMATE = 0.45
 PERSONAL = 1.2
 D_TH = 1.0
+MOVING_SPEED = 0.05  # m/s: above it the robot moves (contact attribution)
+FREEZE_TIME = 5.0  # s without progress that make a freezing event
+FREEZE_PROGRESS = 0.1  # m closer to the goal that make progress
 
 
 @dataclass(frozen=True)
@@ -48,6 +70,10 @@ class EpisodeMetrics:
     human_collisions: int
     obstacle_collisions: int
     collision_time: float
+    robot_fault_contacts: int
+    person_fault_contacts: int
+    robot_fault_steps: int
+    person_fault_steps: int
     time_to_goal: float
     path_length: float
     min_human_distance: float
@@ -56,6 +82,8 @@ class EpisodeMetrics:
     time_personal: float
     protective_stops: int
     stop_time: float
+    freezing_events: int
+    freezing_time: float
     path_irregularity: float
     mean_jerk: float
     planner_ms_mean: float
@@ -84,11 +112,76 @@ def path_length(positions: FloatArray) -> float:
     return float(np.sum(np.linalg.norm(np.diff(positions, axis=0), axis=1)))
 
 
-def human_distances(robot_xy: FloatArray, humans: FloatArray) -> FloatArray:
-    """Distance from the robot to the nearest human at every sample (inf without humans)."""
+def person_distances(robot_xy: FloatArray, humans: FloatArray, present: NDArray[np.bool_] | None = None) -> FloatArray:
+    """Distance from the robot (T, 2) to every person (T, K, 2) at every sample, (T, K); inf
+    where the person is absent (``present`` False; None: everyone is present)."""
+    d = np.linalg.norm(humans - robot_xy[:, None, :], axis=-1)
+    return d if present is None else np.where(present, d, np.inf)
+
+
+def human_distances(robot_xy: FloatArray, humans: FloatArray, present: NDArray[np.bool_] | None = None) -> FloatArray:
+    """Distance from the robot to the nearest human present at every sample (inf without one)."""
     if humans.shape[1] == 0:
         return np.full(robot_xy.shape[0], np.inf)
-    return np.linalg.norm(humans - robot_xy[:, None, :], axis=-1).min(axis=1)
+    return person_distances(robot_xy, humans, present).min(axis=1)
+
+
+@dataclass(frozen=True)
+class ContactFaults:
+    """Contacts with humans by fault (definitions in the module docstring)."""
+
+    robot_events: int
+    person_events: int
+    robot_steps: int
+    person_steps: int
+
+
+def robot_at_fault(states: FloatArray, humans: FloatArray) -> NDArray[np.bool_]:
+    """(T, K): the robot moves (|v| > MOVING_SPEED) with person k strictly within +-90 degrees of
+    its direction of travel, i.e. its velocity has a positive component towards the person."""
+    heading = np.stack([np.cos(states[:, 2]), np.sin(states[:, 2])], axis=1)
+    velocity = states[:, 3:4] * heading
+    with np.errstate(invalid="ignore"):  # an absent person's NaN compares False
+        towards = np.einsum("tk,tpk->tp", velocity, humans - states[:, None, :2]) > 0.0
+    return towards & (np.abs(states[:, 3]) > MOVING_SPEED)[:, None]
+
+
+def attribute_contacts(
+    states: FloatArray, humans: FloatArray, present: NDArray[np.bool_] | None, contact_distance: float
+) -> ContactFaults:
+    """Contact events (per person) and contact samples with humans, by fault."""
+    contact = person_distances(states[:, :2], humans, present) < contact_distance  # (T, K)
+    fault = robot_at_fault(states, humans) & contact
+    robot_events = person_events = 0
+    for k in range(contact.shape[1]):
+        edges = rising_edges(contact[:, k])
+        at_fault = int(np.count_nonzero(fault[edges, k]))
+        robot_events += at_fault
+        person_events += edges.size - at_fault
+    robot_step = fault.any(axis=1)
+    person_step = contact.any(axis=1) & ~robot_step
+    return ContactFaults(robot_events, person_events, int(np.count_nonzero(robot_step)),
+                         int(np.count_nonzero(person_step)))
+
+
+def freezing(
+    times: FloatArray, positions: FloatArray, goal_xy: FloatArray,
+    progress: float = FREEZE_PROGRESS, longest: float = FREEZE_TIME,
+) -> tuple[int, float]:
+    """Freezing events (stretches without progress longer than ``longest`` s) and their total
+    length (s); progress as defined in the module docstring."""
+    d = np.linalg.norm(positions - goal_xy[None, :], axis=1)
+    marks = [0]
+    reference = d[0]
+    for i in range(1, d.size):
+        if d[i] <= reference - progress:
+            marks.append(i)
+            reference = d[i]
+    if marks[-1] != d.size - 1:
+        marks.append(d.size - 1)
+    gaps = np.diff(times[marks])
+    frozen = gaps > longest
+    return int(np.count_nonzero(frozen)), float(np.sum(gaps[frozen]))
 
 
 def time_in_band(distances: FloatArray, lo: float, hi: float, dt: float) -> float:
@@ -128,7 +221,9 @@ def compute_metrics(log: EpisodeLog) -> EpisodeMetrics:
     """All metrics of one episode."""
     xy = log.states[:, :2]
     robot = log.robot
-    d_h = human_distances(xy, log.humans)
+    d_h = human_distances(xy, log.humans, log.present)
+    faults = attribute_contacts(log.states, log.humans, log.present, robot.radius + robot.human_radius)
+    freezing_events, freezing_time = freezing(log.times, xy, log.goal[:2])
     human_contact = d_h < robot.radius + robot.human_radius
     obstacle_contact = log.world.signed_distance(xy) < robot.radius
     contact = human_contact | obstacle_contact
@@ -145,6 +240,10 @@ def compute_metrics(log: EpisodeLog) -> EpisodeMetrics:
         human_collisions=h_events,
         obstacle_collisions=o_events,
         collision_time=float(log.dt * np.count_nonzero(contact[:-1])),
+        robot_fault_contacts=faults.robot_events,
+        person_fault_contacts=faults.person_events,
+        robot_fault_steps=faults.robot_steps,
+        person_fault_steps=faults.person_steps,
         time_to_goal=float(log.times[-1]) if log.reached_goal else float("nan"),
         path_length=path_length(xy),
         min_human_distance=float(np.min(d_h)),
@@ -153,6 +252,8 @@ def compute_metrics(log: EpisodeLog) -> EpisodeMetrics:
         time_personal=time_in_band(d_h, INTIMATE, PERSONAL, log.dt),
         protective_stops=int(sum(reasons.values())),
         stop_time=float(log.dt * np.count_nonzero(log.stops)),
+        freezing_events=freezing_events,
+        freezing_time=freezing_time,
         path_irregularity=path_irregularity(log.states, log.goal[:2]),
         mean_jerk=mean_jerk(xy, log.dt),
         planner_ms_mean=mean_ms,

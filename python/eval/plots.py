@@ -5,8 +5,8 @@
   distance to the nearest human and the planner time over time.
 * :func:`animate_episode`: an animated GIF of one episode (pillow writer).
 
-The humans react to the robot, so their tracks differ between planners; the map shows the
-tracks of the first log given.
+Simulated humans react to the robot, so their tracks differ between planners (recorded ones do
+not); the map shows the tracks of the first log given.
 """
 
 from __future__ import annotations
@@ -52,19 +52,26 @@ def draw_world(ax: Axes, world: World) -> None:
 
 
 def draw_humans(ax: Axes, log: EpisodeLog, every: int = 5) -> None:
-    """Human tracks as markers fading from light (start) to dark (end)."""
+    """Human tracks as markers fading from light (start) to dark (end), each person's disc where
+    they were first seen (people absent at a sample have no marker there)."""
     T, k = log.humans.shape[:2]
     if k == 0:
         return
     idx = np.arange(0, T, every)
     alpha = 0.15 + 0.75 * idx / max(T - 1, 1)
     cmap = plt.get_cmap("tab10")
+    present = log.present
     for i in range(k):
+        seen = present[idx, i]
+        if not np.any(present[:, i]):
+            continue
         colour = np.array(cmap(i % 10))
-        rgba = np.tile(colour, (len(idx), 1))
-        rgba[:, 3] = alpha
-        ax.scatter(log.humans[idx, i, 0], log.humans[idx, i, 1], s=12, c=rgba, edgecolors="none", zorder=3)
-        ax.add_patch(CirclePatch(log.humans[0, i], log.robot.human_radius, fill=False, ec=colour, lw=1.0, zorder=3))
+        rgba = np.tile(colour, (int(np.count_nonzero(seen)), 1))
+        rgba[:, 3] = alpha[seen]
+        ax.scatter(log.humans[idx[seen], i, 0], log.humans[idx[seen], i, 1], s=12, c=rgba, edgecolors="none",
+                   zorder=3)
+        first = log.humans[int(np.argmax(present[:, i])), i]
+        ax.add_patch(CirclePatch(first, log.robot.human_radius, fill=False, ec=colour, lw=1.0, zorder=3))
 
 
 def figure_path(path: str | Path) -> Path:
@@ -104,7 +111,7 @@ def plot_episodes(logs: Sequence[EpisodeLog], path: str | Path, title: str | Non
         colour = planner_colour(log.planner, n)
         xy = log.states[:, :2]
         ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=2.0, label=f"{log.planner} ({log.ended_by})", zorder=4)
-        d = human_distances(xy, log.humans)
+        d = human_distances(xy, log.humans, log.present)
         ax_d.plot(log.times, d, color=colour, label=log.planner)
         ax_t.plot(log.times[1:], log.solve_ms, color=colour, label=log.planner)
     start, goal = first.states[0], first.goal
@@ -151,8 +158,10 @@ def animate_episode(log: EpisodeLog, path: str | Path, fps: int = 10, stride: in
         plan = log.plans[i] if i < len(log.plans) else None
         if plan is not None:
             plan_line.set_data(plan[:, 0], plan[:, 1])
-        for h, p in zip(humans, log.humans[i], strict=True):
-            h.center = tuple(p)
+        for h, p, here in zip(humans, log.humans[i], log.present[i], strict=True):
+            h.set_visible(bool(here))
+            if here:
+                h.center = tuple(p)
         stop = i < len(log.stops) and bool(log.stops[i])
         text.set_text(f"{log.planner}  t = {log.times[i]:.1f} s" + ("  STOP" if stop else ""))
         return [robot, trail, plan_line, text, *humans]

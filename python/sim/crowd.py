@@ -9,12 +9,17 @@ two waypoints).
 
 The robot is an agent for the humans: pass its position and velocity to :meth:`Crowd.step`
 and it enters the human-human repulsion like any other person (it is not moved by forces).
+
+:class:`HumanCrowd` is what a closed loop needs of any crowd: this simulated one (a fixed set of
+people, ids ``0..k-1``) and the replay of recorded people (:mod:`humanmpc.sim.recorded`, whose
+set changes as people enter and leave).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -31,6 +36,28 @@ from .social_force import (
 from .world import World
 
 FloatArray = NDArray[np.float64]
+
+
+@runtime_checkable
+class HumanCrowd(Protocol):
+    """The people of an episode as the closed loop sees them, one period per :meth:`step`.
+
+    ``ids`` (k,) names the people present now, ``positions`` (k, 2) gives their positions in
+    the same order (m); an id always means the same person within an episode, and the people
+    present may change from one step to the next. Nobody absent appears in either.
+    """
+
+    @property
+    def time(self) -> float: ...
+
+    @property
+    def ids(self) -> NDArray[np.int64]: ...
+
+    @property
+    def positions(self) -> FloatArray: ...
+
+    def step(self, robot_position: ArrayLike | None = None, robot_velocity: ArrayLike | None = None) -> None:
+        """Advance one period; the robot's state is there for crowds that react to it."""
 
 
 @dataclass(frozen=True)
@@ -118,6 +145,11 @@ class Crowd:
     @property
     def size(self) -> int:
         return self.spec.size
+
+    @property
+    def ids(self) -> NDArray[np.int64]:
+        """Everyone, always: ``0..k-1`` (the simulated crowd's people never leave)."""
+        return np.arange(self.size, dtype=np.int64)
 
     @property
     def positions(self) -> FloatArray:

@@ -3,6 +3,11 @@
 A :class:`Predictor` is fed the humans' *observed* positions once per control step and returns
 their predicted positions at the MPC's nodes, ``(N + 1, k, 2)`` with node 0 the current
 observation. It never sees the simulator's velocities.
+
+The people observed may change from one step to the next (recorded crowds: people enter and
+leave the scene). An observation then carries their ids, ``(k,)`` integers that name the same
+person across steps; the prediction is in the order of that observation, and a person's velocity
+comes from that person's own observations only.
 """
 
 from __future__ import annotations
@@ -25,18 +30,23 @@ class Predictor(Protocol):
     def reset(self) -> None:
         """Forget every past observation (new episode)."""
 
-    def observe(self, time: float, positions: ArrayLike) -> FloatArray:
-        """Record the humans' positions (k, 2) seen at ``time`` and return the prediction
-        (horizon + 1, k, 2)."""
+    def observe(self, time: float, positions: ArrayLike, ids: ArrayLike | None = None) -> FloatArray:
+        """Record the humans' positions (k, 2) seen at ``time`` (with their ids (k,), if the
+        people present may change) and return the prediction (horizon + 1, k, 2)."""
         ...
 
 
 class ConstantVelocityPredictor:
     """Constant velocity model (Schöller et al. 2020).
 
-    The velocity is the finite difference of the last two observations (averaged over the
-    last ``window`` intervals if ``window > 1``); with a single observation the humans are
-    predicted to stand still. The number of humans must not change within an episode.
+    A person's velocity is the finite difference of their last two observations (over the last
+    ``window`` intervals if ``window > 1``, or as many as they have); with a single observation
+    a person is predicted to stand still.
+
+    Without ids the people are the same ones, in the same order, at every step, and their number
+    must not change within an episode. With ids, people may appear and disappear: a person not
+    in an observation is forgotten (if the same id comes back, it starts again from one
+    observation), and a new id starts with one.
     """
 
     def __init__(self, horizon: int = 50, dt: float = 0.1, window: int = 1) -> None:
@@ -45,40 +55,61 @@ class ConstantVelocityPredictor:
         self.horizon = horizon
         self.dt = dt
         self.window = window
-        self._times: list[float] = []
-        self._positions: list[FloatArray] = []
+        self._last_time: float | None = None
+        self._count: int | None = None  # people of the id-less stream
+        self._ids = np.zeros(0, dtype=np.int64)  # of the last observation, in its order
+        self._history: dict[int, list[tuple[float, FloatArray]]] = {}  # id -> its last window + 1 observations
 
     def reset(self) -> None:
-        self._times.clear()
-        self._positions.clear()
+        self._last_time = None
+        self._count = None
+        self._ids = np.zeros(0, dtype=np.int64)
+        self._history.clear()
 
-    def observe(self, time: float, positions: ArrayLike) -> FloatArray:
+    def observe(self, time: float, positions: ArrayLike, ids: ArrayLike | None = None) -> FloatArray:
         pos = np.asarray(positions, dtype=float)
         if pos.ndim != 2 or pos.shape[1] != 2:
             raise ValueError(f"observe: positions must have shape (k, 2), got {pos.shape}")
-        if self._positions and pos.shape != self._positions[-1].shape:
-            raise ValueError(
-                f"observe: the number of humans changed from {self._positions[-1].shape[0]} to {pos.shape[0]}; "
-                "call reset() between episodes"
-            )
-        if self._times and time <= self._times[-1]:
-            raise ValueError(f"observe: time must increase, got {time} after {self._times[-1]}")
-        self._times.append(float(time))
-        self._positions.append(pos.copy())
+        if ids is None:
+            if self._count is not None and pos.shape[0] != self._count:
+                raise ValueError(
+                    f"observe: the number of humans changed from {self._count} to {pos.shape[0]}; "
+                    "call reset() between episodes, or pass the people's ids if the crowd changes"
+                )
+            self._count = pos.shape[0]
+            who = np.arange(pos.shape[0], dtype=np.int64)
+        else:
+            who = np.asarray(ids).reshape(-1)
+            if who.shape[0] != pos.shape[0] or not np.issubdtype(who.dtype, np.integer):
+                raise ValueError(f"observe: ids must be {pos.shape[0]} integers (one per position), got {who!r}")
+            if np.unique(who).size != who.size:
+                raise ValueError(f"observe: ids must be distinct, got {who.tolist()}")
+            who = who.astype(np.int64)
+        if self._last_time is not None and time <= self._last_time:
+            raise ValueError(f"observe: time must increase, got {time} after {self._last_time}")
+        self._last_time = float(time)
         keep = self.window + 1
-        del self._times[:-keep]
-        del self._positions[:-keep]
+        history: dict[int, list[tuple[float, FloatArray]]] = {}
+        for i, p in zip(who.tolist(), pos, strict=True):
+            past = self._history.get(i, [])
+            history[i] = [*past[-(keep - 1):], (float(time), p.copy())]  # keep >= 2
+        self._history = history
+        self._ids = who
         return self.predict()
 
     def velocities(self) -> FloatArray:
-        """Estimated velocities (k, 2) from the stored observations."""
-        if len(self._positions) < 2:
-            return np.zeros_like(self._positions[-1]) if self._positions else np.zeros((0, 2))
-        span = self._times[-1] - self._times[0]
-        return (self._positions[-1] - self._positions[0]) / span
+        """Estimated velocities (k, 2) of the people of the last observation, in its order."""
+        out = np.zeros((self._ids.size, 2))
+        for j, i in enumerate(self._ids.tolist()):
+            obs = self._history[i]
+            if len(obs) >= 2:
+                (t_old, p_old), (t_new, p_new) = obs[0], obs[-1]
+                out[j] = (p_new - p_old) / (t_new - t_old)
+        return out
 
     def predict(self) -> FloatArray:
-        if not self._positions:
+        if self._last_time is None:
             raise RuntimeError("predict: no observation yet; call observe() first")
+        now = np.array([self._history[i][-1][1] for i in self._ids.tolist()]).reshape(-1, 2)
         t = self.dt * np.arange(self.horizon + 1)
-        return self._positions[-1][None, :, :] + t[:, None, None] * self.velocities()[None, :, :]
+        return now[None, :, :] + t[:, None, None] * self.velocities()[None, :, :]

@@ -1,23 +1,42 @@
-"""Seeded, reproducible evaluation scenarios.
+"""Seeded, reproducible evaluation scenarios: simulated crowds and recorded ones.
 
-Every scenario is a pure function of its seed (``numpy.random.default_rng(seed)``) and gives
-the world, the crowd's initial state and waypoints, the robot's start state and goal, and a
-time limit. Humans start walking at their desired speed towards their first waypoint and
-walk back and forth between their waypoints for the whole episode (so the scene stays busy
-however long the robot needs). Desired walking speeds are drawn from U(0.9, 1.3) m/s around
-the 1.1-1.3 m/s usually measured for people walking indoors; the social force model caps the
-speed at 1.3 times the desired one (Helbing & Molnár).
+Every scenario is a pure function of its seed and gives the world, the crowd, the robot's start
+state and goal, and a time limit.
+
+**Simulated** (``SIMULATED_SCENARIOS``; any seed, ``numpy.random.default_rng(seed)``): the crowd's
+initial state and waypoints for the social force model. Humans start walking at their desired
+speed towards their first waypoint and walk back and forth between their waypoints for the
+whole episode (so the scene stays busy however long the robot needs). Desired walking speeds
+are drawn from U(0.9, 1.3) m/s around the 1.1-1.3 m/s usually measured for people walking
+indoors; the social force model caps the speed at 1.3 times the desired one (Helbing & Molnár).
+
+**Recorded** (``RECORDED_SCENARIOS``: ``biwi_eth``, ``biwi_hotel``, ``crowds_zara01``; seeds
+``0..RECORDED_CROSSINGS - 1``): real pedestrians replayed as recorded, whatever the robot does
+(:mod:`humanmpc.sim.recorded`), in an empty world whose bounds cover every annotated position
+with a 1 m margin (the recordings have no static obstacles). The robot crosses the scene along
+its main walking direction, the principal axis of all annotated positions, on the line through
+their median: from the 10th to the 90th percentile of the positions along that axis (the part
+of the scene people walk through), so a crossing is 10.7 m (hotel) to 13.5 m (eth) long. Seed ``s`` is crossing
+``s``: start time ``s // 2``, direction ``s % 2`` (0: towards increasing position along the
+axis, oriented so that its larger component is positive; 1: back). The four start times are
+one per quarter of the recording's admissible starts (those that leave ``RECORDED_TIME_LIMIT``
+of recording), the busiest in it: the largest mean number of people present over the
+crossing's nominal duration (its length at v_ref, sampled every 0.4 s), among the start times
+at which nobody is within 1 m of either end of the crossing (ties: the earliest).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import functools
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .crowd import CrowdSpec
+from .crowd import Crowd, CrowdSpec, HumanCrowd
+from .recorded import ANNOTATION_PERIOD, RecordedCrowd, RecordedCrowdSpec, Recording, load_recording
+from .social_force import SocialForceParams
 from .world import Circle, Obstacle, Polygon, World
 
 FloatArray = NDArray[np.float64]
@@ -32,11 +51,19 @@ class Scenario:
     name: str
     seed: int
     world: World
-    crowd: CrowdSpec
+    crowd: CrowdSpec | RecordedCrowdSpec  # simulated (social force) or recorded (replayed)
     robot_start: FloatArray  # [px, py, theta, v]
     goal: FloatArray  # [gx, gy, gtheta, v_ref]
     time_limit: float
     goal_tolerance: float = 0.3
+
+    def start_crowd(self, social_force: SocialForceParams | None = None) -> HumanCrowd:
+        """The crowd of a new episode: the social force model run with ``social_force`` (its
+        ``dt`` is the period of a step), or the recorded people replayed at that period."""
+        params = social_force or SocialForceParams()
+        if isinstance(self.crowd, RecordedCrowdSpec):
+            return RecordedCrowd(self.crowd, params.dt)
+        return Crowd(self.crowd, self.world, params)
 
 
 def _heading(a: FloatArray, b: FloatArray) -> float:
@@ -183,18 +210,117 @@ def corridor(seed: int) -> Scenario:
     return Scenario("corridor", seed, world, crowd, x0, goal, time_limit=60.0)
 
 
+RECORDED_CROSSINGS = 8  # per recorded scene: 4 start times x 2 directions
+RECORDED_TIME_LIMIT = 60.0  # s
+_START_TIMES = RECORDED_CROSSINGS // 2
+_ENDS_QUANTILES = (0.10, 0.90)  # the crossing's ends, along the scene's main walking direction
+_FREE_AT_ENDS = 1.0  # m: nobody this close to an end of the crossing at its start time
+_WORLD_MARGIN = 1.0  # m around every annotated position
+
+
+@dataclass(frozen=True)
+class Crossings:
+    """Where and when the robot crosses a recorded scene (module docstring)."""
+
+    ends: FloatArray  # (2, 2): the crossing's two ends, direction 0 goes from ends[0] to ends[1]
+    start_times: FloatArray  # (_START_TIMES,) recording times (s)
+    bounds: tuple[float, float, float, float]
+
+    def crossing(self, index: int) -> tuple[float, FloatArray, FloatArray]:
+        """Start time (recording time, s), start and goal positions of crossing ``index``."""
+        t0 = float(self.start_times[index // 2])
+        a, b = self.ends if index % 2 == 0 else self.ends[::-1]
+        return t0, a.copy(), b.copy()
+
+
+def plan_crossings(recording: Recording, time_limit: float = RECORDED_TIME_LIMIT) -> Crossings:
+    """The crossings of a recorded scene (the rule is in the module docstring); ``ValueError`` if
+    the recording is too short or too crowded at its ends to give them."""
+    pts = recording.annotations()
+    if pts.shape[0] < 3:
+        raise ValueError(f"{recording.name}: too few annotations ({pts.shape[0]}) to lay out a crossing")
+    centre = np.median(pts, axis=0)
+    _, vecs = np.linalg.eigh(np.cov((pts - pts.mean(axis=0)).T))
+    axis = vecs[:, -1] * (1.0 if vecs[np.argmax(np.abs(vecs[:, -1])), -1] > 0 else -1.0)
+    along = (pts - centre) @ axis
+    lo, hi = np.quantile(along, _ENDS_QUANTILES)
+    ends = np.stack([centre + lo * axis, centre + hi * axis])
+    first, last = recording.duration
+    latest = last - time_limit
+    if latest < first:
+        raise ValueError(f"{recording.name}: the recording lasts {last - first:.1f} s, shorter than the crossing's "
+                         f"time limit {time_limit:.1f} s")
+    n_cand = int(np.floor((latest - first) / ANNOTATION_PERIOD + 1e-9)) + 1
+    candidates = np.round(first + ANNOTATION_PERIOD * np.arange(n_cand), 9)
+    window = ANNOTATION_PERIOD * np.arange(int(np.ceil((hi - lo) / V_REF / ANNOTATION_PERIOD)) + 1)
+    busy = recording.present(candidates[:, None] + window[None, :]).sum(axis=-1).mean(axis=-1)
+    free = np.ones(candidates.shape, dtype=bool)
+    for j, t in enumerate(candidates):
+        _, pos = recording.at(float(t))
+        if pos.shape[0]:
+            free[j] = np.linalg.norm(pos[:, None, :] - ends[None], axis=-1).min() >= _FREE_AT_ENDS
+    starts: list[float] = []
+    for block in np.array_split(np.arange(candidates.size), _START_TIMES):
+        ok = block[free[block]]
+        if ok.size == 0:
+            raise ValueError(f"{recording.name}: no start time in [{candidates[block[0]]:.1f}, "
+                             f"{candidates[block[-1]]:.1f}] s leaves both ends of the crossing free")
+        starts.append(float(candidates[ok[np.argmax(busy[ok])]]))
+    xmin, ymin = np.minimum(pts.min(axis=0), ends.min(axis=0)) - _WORLD_MARGIN
+    xmax, ymax = np.maximum(pts.max(axis=0), ends.max(axis=0)) + _WORLD_MARGIN
+    return Crossings(ends, np.array(starts), (float(xmin), float(xmax), float(ymin), float(ymax)))
+
+
+@functools.lru_cache(maxsize=8)
+def _crossings(name: str) -> Crossings:
+    return plan_crossings(load_recording(name))
+
+
+def recorded_scene(name: str, seed: int) -> Scenario:
+    """Crossing ``seed`` of the recorded scene ``name`` (module docstring)."""
+    if not 0 <= seed < RECORDED_CROSSINGS:
+        raise ValueError(f"{name} is a recorded scene with {RECORDED_CROSSINGS} crossings: "
+                         f"seeds 0..{RECORDED_CROSSINGS - 1}, got {seed}")
+    recording = load_recording(name)
+    plan = _crossings(name)
+    t0, start, goal = plan.crossing(seed)
+    x0, g = _robot(start, goal)
+    return Scenario(name, seed, World((), plan.bounds), RecordedCrowdSpec(recording, t0), x0, g,
+                    time_limit=RECORDED_TIME_LIMIT)
+
+
+SIMULATED_SCENARIOS = ("circle_crossing", "corridor", "crossing_group", "random_crowded_cluttered")
+RECORDED_SCENARIOS = ("biwi_eth", "biwi_hotel", "crowds_zara01")
+
 SCENARIOS: dict[str, Callable[[int], Scenario]] = {
     "random_crowded_cluttered": random_crowded_cluttered,
     "crossing_group": crossing_group,
     "circle_crossing": circle_crossing,
     "corridor": corridor,
+    **{name: functools.partial(recorded_scene, name) for name in RECORDED_SCENARIOS},
 }
 
 
+def scenario_seeds(name: str) -> int | None:
+    """How many seeds scenario ``name`` has (``None``: any seed >= 0 is a scenario)."""
+    return RECORDED_CROSSINGS if name in RECORDED_SCENARIOS else None
+
+
+def check_seeds(name: str, seeds: Sequence[int]) -> None:
+    """``ValueError`` saying which seeds scenario ``name`` has, if ``seeds`` holds another one."""
+    count = scenario_seeds(name)
+    bad = [int(s) for s in seeds if int(s) < 0 or (count is not None and int(s) >= count)]
+    if bad:
+        valid = "seeds >= 0" if count is None else f"seeds 0..{count - 1} (its crossings)"
+        raise ValueError(f"scenario {name} has {valid}; got seed(s) {', '.join(map(str, bad[:5]))}"
+                         + (" ..." if len(bad) > 5 else ""))
+
+
 def make_scenario(name: str, seed: int) -> Scenario:
-    """The scenario ``name`` for ``seed``; ``ValueError`` listing the valid names otherwise."""
+    """The scenario ``name`` for ``seed``; ``ValueError`` listing the valid names (or seeds) otherwise."""
     try:
         factory = SCENARIOS[name]
     except KeyError:
         raise ValueError(f"unknown scenario {name!r}; valid scenarios: {', '.join(sorted(SCENARIOS))}") from None
+    check_seeds(name, [seed])
     return factory(int(seed))
