@@ -32,24 +32,20 @@ no speed limit beyond the spec's bounds, the spec's parameters (the paper's valu
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
 from ..bindings import load
-from ..codegen.build import build, is_stale
-from ..codegen.generate import MANIFEST, generate
-from ..codegen.spec import Spec
 from ..solver import Solver
 from .global_path import GlobalPlanner, GridConfig, local_segment
 from .interface import Observation, PlanResult
+from .solver_dir import DEFAULT_SOLVER_DIR as DEFAULT_SOLVER_DIR  # moved to solver_dir, re-exported here
+from .solver_dir import ensure_solver as ensure_solver
 
-DEFAULT_SOLVER_DIR = Path("generated") / "paper"  # as humanmpc-gen generate writes it, in the working folder
 GOAL_TAPER = 0.5  # v_ref <= GOAL_TAPER * distance to the goal
 LOOP_RATIO = 0.5  # a plan whose end is nearer its start than half its length is a loop
 LOOP_MIN_LENGTH = 1.0  # [m] shorter plans (stopping, waiting, arriving) are never loops
@@ -106,18 +102,6 @@ class MPCPlannerConfig:
         the goal taper and the choice of the closest N_h humans."""
         return MPCPlannerConfig(global_path=False, approach=False, speed_limit=False, loop_restart=None,
                                 params={})
-
-
-def ensure_solver(solver_dir: Path = DEFAULT_SOLVER_DIR, spec: Spec | None = None) -> Path:
-    """The solver of ``spec`` (default: the paper's) in solver_dir, generated and built if needed."""
-    spec = spec or Spec()
-    manifest = solver_dir / MANIFEST
-    current = manifest.is_file() and f'"spec_hash": "{spec.digest()}"' in manifest.read_text()
-    if not current:
-        generate(spec, solver_dir, force=manifest.is_file(), log=lambda m: print(m, file=sys.stderr))
-    if is_stale(solver_dir):
-        build(solver_dir, log=lambda m: print(m, file=sys.stderr))
-    return solver_dir
 
 
 class MPCPlanner:
