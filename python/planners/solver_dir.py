@@ -13,8 +13,8 @@ Two kinds of solver folders, never mixed up:
   ``.humanmpc-cache`` file (:data:`CACHE_MARKER`). It is generated in a staging folder, marked and
   built there, then renamed into place, under a lock (``generated/.cache/.lock``): a run that is
   interrupted leaves no half-made folder, and two runs do not generate the same spec at once. Only a
-  marked folder is ever rebuilt or replaced; a folder at a cache path without the marker is reported
-  and left alone.
+  marked folder is ever rebuilt or replaced; a folder at a cache path without the marker is left alone
+  (used as it is if it holds that spec's built solver, reported otherwise).
 
 :func:`select_solver` chooses the solver of this process (the commands call it with their ``--spec``
 and ``--solver-dir`` before any planner is made): :func:`ensure_solver` without arguments returns
@@ -128,19 +128,24 @@ def _locked(root: Path) -> Iterator[None]:
 def cached_solver(spec: Spec, root: Path = CACHE_DIR, log: Callable[[str], None] | None = None) -> Path:
     """The cache folder of ``spec``'s built solver, generated and built when missing or stale.
 
-    A folder at that path that the tools did not create (no :data:`CACHE_MARKER`) is a
-    ``SolverDirError`` and stays as it is."""
+    A folder at that path that the tools did not create (no :data:`CACHE_MARKER`) stays as it is: it
+    is used if it holds the spec's built solver, else it is a ``SolverDirError``."""
     say = log or (lambda m: print(m, file=sys.stderr))
     d = cache_dir(spec, root)
     with _locked(root):
         if d.exists() or d.is_symlink():
             if not is_tool_created(d) or d.is_symlink():
-                raise SolverDirError(
-                    f"{d} is where humanmpc's tools keep the solver '{spec.name}' of spec sha256 {spec.digest()}, "
-                    f"but it holds files they did not create (no {CACHE_MARKER} marker; the spec sha256 in its "
-                    f"{MANIFEST}: {held_spec_hash(d) or 'none'}): they leave it alone. Move it away or delete it; "
-                    "to use a package in it as it is, give it with --solver-dir"
-                )
+                try:
+                    check_solver_dir(d, spec)  # the spec's built solver after all: used as it is
+                    return d
+                except SolverDirError:
+                    raise SolverDirError(
+                        f"{d} is where humanmpc's tools keep the solver '{spec.name}' of spec sha256 "
+                        f"{spec.digest()}, but it holds files they did not create (no {CACHE_MARKER} marker; the "
+                        f"spec sha256 in its {MANIFEST}: {held_spec_hash(d) or 'none'}), not that spec's built "
+                        "solver: they leave it alone. Move it away or delete it; to use a package in it as it is, "
+                        "give it with --solver-dir"
+                    ) from None
             if held_spec_hash(d) == spec.digest():
                 if is_stale(d):
                     build(d, log=say)
