@@ -43,9 +43,9 @@ def choose_solver(spec_file: Path | None, solver_dir: Path | None) -> EpisodeCon
     ``SpecError`` for an invalid spec, ``SolverDirError`` for a folder that cannot be used,
     ``ValueError`` for a solver whose interval is not the simulation's control period."""
     spec = load_spec(spec_file) if spec_file is not None else None
-    select_solver(spec, solver_dir, str(spec_file) if spec_file is not None else None)
+    source = str(spec_file) if spec_file is not None else None
     if solver_dir is not None:
-        dims = check_solver_dir(solver_dir, spec)["dims"]
+        dims = check_solver_dir(solver_dir, spec, source)["dims"]
         assert isinstance(dims, dict)
         N, dt, where = int(dims["N"]), float(dims["dt"]), f"the solver in {solver_dir}"
     else:
@@ -56,6 +56,7 @@ def choose_solver(spec_file: Path | None, solver_dir: Path | None) -> EpisodeCon
         raise ValueError(f"{where}: horizon.T / horizon.N = {dt:g} s, but the simulation's control period and the "
                          f"spacing of its predictions are {base.dt:g} s: give horizon.T = {base.dt:g} * horizon.N "
                          f"(T: {base.dt * N:g} for N: {N})")
+    select_solver(spec, solver_dir, source)
     return replace(base, horizon=N)
 
 
