@@ -1,7 +1,7 @@
 # humanmpc: the README's commands.
 #   make test   install what is missing (apt packages as root, .venv, pip) and run the whole suite
-#   make demo   generate + build the default solver, run the crossing-group scenario with the MPC and
-#               the DWB baseline, print the metrics side by side and write the figure
+#   make demo   generate + build the default solver (once, into generated/.cache/), run the crossing-group
+#               scenario with the MPC and the DWB baseline, print the metrics side by side and write the figure
 # Each target installs only what it uses: the demo the compiler and the tool's own Python
 # dependencies; the firmware target the Cortex-M cross compiler and QEMU; the tests everything.
 SHELL := /bin/bash
@@ -70,9 +70,9 @@ test: venv-test
 	$(PY) -m mypy codegen python
 	$(PY) -m pytest tests
 
+# The demo generates and builds the default solver into the tools' cache (generated/.cache/paper-<hash>/)
+# when it is not there yet; it writes no other solver folder.
 demo: venv
-	$(GEN) generate -o generated/paper --force
-	$(GEN) build generated/paper
 	$(GEN) demo --out out/demo
 
 bench: venv
@@ -95,4 +95,4 @@ lint: venv-test
 	$(PY) -m pytest -q tests/test_packaging.py -k import_layer
 
 clean:
-	rm -rf build generated/*/ .pytest_cache .ruff_cache .mypy_cache .hypothesis
+	rm -rf build generated/*/ generated/.cache .pytest_cache .ruff_cache .mypy_cache .hypothesis

@@ -1,10 +1,11 @@
-"""The cumulative ablation of docs/evaluation.md ("What changed in round 2"), on the evaluation's seeds.
+"""The cumulative ablation of the C controller (docs/evaluation.md), on the evaluation's seeds.
 
-Starts from the first round's evaluation configuration and adds this round's changes one at a time,
-ending at MPCPlannerConfig() (registered as "mpc"); prints, per step and scenario, the contact events,
-the runs that reached the goal, the mean minimum distance to humans, the mean time inside d_th and the
-mean time to the goal, and the same for the DWB. Nothing here is chosen: the settings were fixed
-before (docs/weight_selection.py, seeds 100..139).
+Starts from the paper's configuration (``MPCPlanner.paper``: its weights, Gauss-Newton, the goal pose
+alone) and adds the controller's parts one at a time, ending at the spec's defaults (registered as
+"mpc"); prints, per step and scenario, the contact events, the runs that reached the goal, the mean
+minimum distance to humans, the mean time inside d_th and the mean time to the goal, and the same for
+the DWB. Nothing here is chosen: the settings were fixed before (docs/weight_selection.py, seeds
+100..139).
 
     .venv/bin/python docs/ablation.py [OUT_DIR]     # about 3 minutes with 2 workers
 """
@@ -12,36 +13,42 @@ before (docs/weight_selection.py, seeds 100..139).
 from __future__ import annotations
 
 import sys
-from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from humanmpc.eval.evaluate import evaluate
-from humanmpc.planners.mpc import MPCPlanner, MPCPlannerConfig, with_params
+from humanmpc.planners.mpc import MPCPlanner, paper_params
 from humanmpc.planners.registry import register_planner
-from humanmpc.sim.scenarios import SCENARIOS
+from humanmpc.sim.scenarios import SIMULATED_SCENARIOS as SCENARIOS
 
 SEEDS = list(range(20))
-PAPER_W_GOAL = (0.5, 0.5, 0.0, 250.0)
 
 
-def steps() -> dict[str, MPCPlannerConfig]:
-    final = MPCPlannerConfig()
-    round1 = replace(with_params(final, w_goal=PAPER_W_GOAL), path_humans=True, loop_restart=None,
-                     approach_position=None, approach_stop=None)
-    static_path = replace(round1, path_humans=False)
-    restart = replace(static_path, loop_restart=final.loop_restart)
-    approach = replace(restart, approach_position=final.approach_position, approach_stop=final.approach_stop)
-    return {"round1": round1, "static_path": static_path, "loop_restart": restart, "approach": approach,
-            "w_v50": final}
+def steps() -> dict[str, tuple[dict[str, Any], bool]]:
+    """Each step: the runtime parameters that differ from the defaults, and whether the path is given."""
+    paper = paper_params()
+    def without(*keys: str) -> dict[str, Any]:
+        return {k: v for k, v in paper.items() if k not in keys}
+    return {
+        "paper": (paper, False),
+        "path": (without(), True),
+        "speed_limit": (without("speed_limit", "lookahead"), True),
+        "exact_hessian_slack": (without("speed_limit", "lookahead", "exact_hessian", "slack_l1"), True),
+        "weights": (without("speed_limit", "lookahead", "exact_hessian", "slack_l1", "q", "w_goal"), True),
+        "approach_loop": (without("speed_limit", "lookahead", "exact_hessian", "slack_l1", "q", "w_goal",
+                                  "approach", "loop_ratio"), True),
+        "defaults": ({}, True),
+    }
 
 
 def main() -> None:
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "out/ablation")
     configs = steps()
-    for name, config in configs.items():
-        register_planner(name, lambda c=config, n=name: MPCPlanner(config=c, name=n), replace=True)
+    for name, (params, path) in configs.items():
+        register_planner(name, lambda p=params, g=path, n=name: MPCPlanner(params=p, global_path=g, name=n),
+                         replace=True)
     result = evaluate(sorted(SCENARIOS), [*configs, "dwb"], SEEDS, out, workers=2, figures=False, progress=False)
     print("| step | " + " | ".join(sorted(SCENARIOS)) + " |")
     print("|---|" + "---|" * len(SCENARIOS))

@@ -1,6 +1,6 @@
 """How the evaluation's speed-tracking weight and collision-cost height were chosen (docs/evaluation.md).
 
-Runs the evaluation's MPC (MPCPlannerConfig(), everything but the two weights as in the evaluation)
+Runs the evaluation's MPC (the C controller with the spec's defaults, everything but the two weights)
 for every w_v (the stage weight on (v - v_ref)^2, w_goal[3]; the paper's 250) in W_SPEED and every q
 (the height of the collision potential; the paper's 2) in QS, and the DWB baseline, on the tuning
 seeds 100..139 (disjoint from the evaluation's seeds 0..19). For each pair it counts the comparisons
@@ -17,9 +17,9 @@ import sys
 from pathlib import Path
 
 from humanmpc.eval.evaluate import evaluate
-from humanmpc.planners.mpc import MPCPlanner, MPCPlannerConfig, with_params
+from humanmpc.planners.mpc import MPCPlanner
 from humanmpc.planners.registry import register_planner
-from humanmpc.sim.scenarios import SCENARIOS
+from humanmpc.sim.scenarios import SIMULATED_SCENARIOS as SCENARIOS
 
 W_SPEED = (250.0, 100.0, 50.0, 25.0)
 QS = (20.0, 50.0, 100.0)
@@ -29,14 +29,13 @@ BETTER = {"collisions": -1, "reached_goal": 1, "min_human_distance": 1, "time_wi
 
 def main() -> None:
     out = Path(sys.argv[1] if len(sys.argv) > 1 else "out/weight_selection")
-    base = MPCPlannerConfig()
-    w_goal = list(base.params.get("w_goal", (0.5, 0.5, 0.0, 250.0)))
+    w_goal = (0.5, 0.5, 0.0)
     names: dict[str, tuple[float, float]] = {}
     for w in W_SPEED:
         for q in QS:
             name = f"mpc_w{w:g}_q{q:g}"
-            config = with_params(base, w_goal=[*w_goal[:3], w], q=q)
-            register_planner(name, lambda c=config, n=name: MPCPlanner(config=c, name=n), replace=True)
+            params = {"w_goal": (*w_goal, w), "q": q}
+            register_planner(name, lambda p=params, n=name: MPCPlanner(params=p, name=n), replace=True)
             names[name] = (w, q)
     result = evaluate(sorted(SCENARIOS), [*names, "dwb"], SEEDS, out, workers=2, figures=False, progress=False)
     table: dict[tuple[str, str], dict[str, float]] = {}

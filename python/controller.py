@@ -109,7 +109,7 @@ class Controller:
             raise ValueError(f"pose must be (x, y, theta), got shape {pose_a.shape}")
         P = _points("path", path, 2, self.max_path_points, "controller.max_path_points")
         Q = _points("people", people, 4, self.max_tracks, "controller.max_tracks")
-        O = _points("obstacles", obstacles, 2, self.max_obstacle_points, "controller.max_obstacle_points")
+        K = _points("obstacles", obstacles, 2, self.max_obstacle_points, "controller.max_obstacle_points")
         k = Q.shape[0]
         if ids is None:
             id_a = np.arange(k, dtype=np.int64)
@@ -148,8 +148,8 @@ class Controller:
                 given = np.all(np.isfinite(cov), axis=1)
                 self._has_cov[:k] = given
                 self._cov[:k] = np.where(given[:, None], cov, 0.0)
-            c.n_obstacles = O.shape[0]
-            self._obstacles[: O.shape[0]] = O
+            c.n_obstacles = K.shape[0]
+            self._obstacles[: K.shape[0]] = K
             self._c_step(self._ctl, self._in, self._out)
             return ControllerResult(np.ndarray((), self._out_dtype, self._out_buffer[:]))
 

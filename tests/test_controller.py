@@ -263,9 +263,9 @@ def test_without_a_path_or_a_goal_the_controller_says_so_and_brakes(ctl: Control
 
 
 def test_inputs_beyond_the_capacities_are_refused_naming_the_spec_key(ctl: Controller) -> None:
-    with pytest.raises(ValueError, match="controller.max_tracks"):
+    with pytest.raises(ValueError, match=r"controller\.max_tracks"):
         ctl.step(0.0, pose=(0, 0, 0), v=0.0, goal=(1, 0, 0), people=np.zeros((ctl.max_tracks + 1, 4)))
-    with pytest.raises(ValueError, match="controller.max_path_points"):
+    with pytest.raises(ValueError, match=r"controller\.max_path_points"):
         ctl.step(0.0, pose=(0, 0, 0), v=0.0, path=np.zeros((ctl.max_path_points + 1, 2)))
     with pytest.raises(ValueError, match=r"shape \(n, 4\)"):
         ctl.step(0.0, pose=(0, 0, 0), v=0.0, goal=(1, 0, 0), people=np.zeros((3, 2)))

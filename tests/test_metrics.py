@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from humanmpc.eval.episode import EpisodeLog
-from humanmpc.eval.metrics import compute_metrics, freezing, mean_jerk, rising_edges
+from humanmpc.eval.metrics import compute_metrics, freezing, mean_jerk, omega_flip_rate, rising_edges
 from humanmpc.sim.robot import RobotModel
 from humanmpc.sim.world import Circle, World
 
@@ -97,6 +97,14 @@ def test_jerk_of_a_cubic_position_profile_is_its_constant_third_derivative() -> 
     xy = np.column_stack([0.5 * t**3, np.zeros_like(t)])  # x''' = 3
     assert mean_jerk(xy, DT) == pytest.approx(3.0)
     assert mean_jerk(straight(), DT) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_turn_rate_flip_is_a_change_of_omega_above_2_rad_per_s_between_steps() -> None:
+    """Hand-counted: omega 0, 1.5, -1.5 (a 3 rad/s jump), -0.4 (1.1), 1.7 (2.1), 1.7 over 6 steps."""
+    controls = np.column_stack([np.zeros(6), [0.0, 1.5, -1.5, -0.4, 1.7, 1.7]])
+    assert omega_flip_rate(controls) == pytest.approx(2 / 6)
+    assert omega_flip_rate(np.column_stack([np.zeros(4), [0.0, 2.0, 0.0, 2.0]])) == 0.0  # exactly 2: no flip
+    assert omega_flip_rate(np.zeros((0, 2))) == 0.0
 
 
 def test_protective_stops_are_counted_as_events_per_reason() -> None:

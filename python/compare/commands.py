@@ -18,6 +18,16 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         from .report import run_compare_from_args
 
         return run_compare_from_args(args)
+    if args.controller is not None:
+        from .controller_bench import controller_markdown, run_controller_bench
+
+        if args.controller > 1000:
+            raise SpecError([f"--controller: {args.controller} tracks: at most 1000"], "bench")
+        result = run_controller_bench(load_spec(args.spec), args.controller, seeds=args.seeds, steps=args.steps,
+                                      out_dir=args.out)
+        print(controller_markdown(result), end="")
+        print(f"(written to {args.out / 'controller.json'} and {args.out / 'controller.md'})")
+        return 0
 
     try:
         humans = [int(h) for h in args.humans.split(",")]
@@ -40,5 +50,8 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seeds", type=positive_int, default=3, help="closed loops per crowd size (default: 3)")
     p.add_argument("--steps", type=positive_int, default=300, help="RTI steps per closed loop (default: 300)")
     p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
+    p.add_argument("--controller", type=positive_int, metavar="TRACKS", nargs="?", const=30,
+                   help="time the whole controller step (predictions, selection, OCP, monitors) with TRACKS "
+                   "tracked people (default 30) instead of the RTI alone")
     add_compare_arguments(p)
     p.set_defaults(func=_cmd_bench)

@@ -9,18 +9,63 @@ Hook them into the CLI's sub-parsers::
     return args.func(args)
 
 Each ``func`` returns a process exit code: 0 on success, 2 for unknown names (with the valid
-ones listed on stderr).
+ones listed on stderr), an invalid ``--spec`` (every problem with its key) or a solver folder that
+cannot be used (named, with what to do); all of these are checked before any episode runs.
+
+The three commands take ``--spec FILE`` and ``--solver-dir DIR`` for the solver of the MPC planners
+(``mpc``, ``mpc_paper``): ``--spec`` alone has the tools generate and build that spec's solver into
+their cache, ``generated/.cache/<name>-<hash>/`` (reused while the spec is unchanged); ``--solver-dir``
+uses a generated and built package as it is, never regenerating or rebuilding it (with ``--spec`` as
+well, it must hold that spec's solver); neither, the built-in default spec's solver in the cache
+(:mod:`humanmpc.planners.solver_dir`). The episodes' prediction horizon is the solver's N; its
+interval T / N must be the simulation's control period, 0.1 s.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from ..codegen.cli import non_negative_int, positive_int
+from ..codegen.spec import Spec, load_spec
 from ..planners.registry import planner_names
+from ..planners.solver_dir import CACHE_DIR, SolverDirError, check_solver_dir, select_solver
 from ..sim.scenarios import RECORDED_CROSSINGS, RECORDED_SCENARIOS, SCENARIOS, SIMULATED_SCENARIOS
+from .episode import EpisodeConfig
+
+
+def choose_solver(spec_file: Path | None, solver_dir: Path | None) -> EpisodeConfig:
+    """Select the MPC planners' solver from ``--spec`` / ``--solver-dir`` (checked now; a spec's solver
+    is generated only when a planner first needs it) and return the episode settings that fit it.
+
+    ``SpecError`` for an invalid spec, ``SolverDirError`` for a folder that cannot be used,
+    ``ValueError`` for a solver whose interval is not the simulation's control period."""
+    spec = load_spec(spec_file) if spec_file is not None else None
+    source = str(spec_file) if spec_file is not None else None
+    if solver_dir is not None:
+        dims = check_solver_dir(solver_dir, spec, source)["dims"]
+        assert isinstance(dims, dict)
+        N, dt, where = int(dims["N"]), float(dims["dt"]), f"the solver in {solver_dir}"
+    else:
+        resolved = spec or Spec()
+        N, dt, where = resolved.horizon.N, resolved.dt, str(spec_file or "the built-in spec")
+    base = EpisodeConfig()
+    if abs(dt - base.dt) > 1e-9:
+        raise ValueError(f"{where}: horizon.T / horizon.N = {dt:g} s, but the simulation's control period and the "
+                         f"spacing of its predictions are {base.dt:g} s: give horizon.T = {base.dt:g} * horizon.N "
+                         f"(T: {base.dt * N:g} for N: {N})")
+    select_solver(spec, solver_dir, source)
+    return replace(base, horizon=N)
+
+
+def _print_solver(planner: object) -> None:
+    solver = getattr(planner, "solver", None)
+    if solver is not None and hasattr(solver, "spec_hash"):
+        d = solver.dims
+        print(f"solver: {solver.path} ('{solver.name}', spec sha256 {solver.spec_hash}, N={d.N}, N_h={d.nh}, "
+              f"dt={d.dt:g} s)")
 
 
 def _simulate(args: argparse.Namespace) -> int:
@@ -37,11 +82,13 @@ def _simulate(args: argparse.Namespace) -> int:
         if args.animate:
             animation_path(args.animate)
         scenario = make_scenario(args.scenario, args.seed)
-        planner = make_planner(args.planner)
+        config = choose_solver(args.spec, args.solver_dir)
+        planner = make_planner(args.planner)  # an MPC planner generates and builds a --spec's solver here
     except ValueError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
-    log = run_episode(scenario, planner)
+    _print_solver(planner)
+    log = run_episode(scenario, planner, config)
     metrics = compute_metrics(log)
     print(f"{args.scenario} seed {args.seed} with {args.planner}: ended by {log.ended_by} at t = {log.times[-1]:.1f} s")
     for key, value in metrics.as_row().items():
@@ -66,13 +113,19 @@ def _evaluate(args: argparse.Namespace) -> int:
         validate_names(scenarios, planners, range(args.first_seed, args.first_seed + args.seeds))
         if args.seeds < 1 or args.workers < 1:
             raise ValueError("--seeds and --workers must be >= 1")
+        config = choose_solver(args.spec, args.solver_dir)
     except ValueError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
-    result = evaluate(
-        scenarios, planners, list(range(args.first_seed, args.first_seed + args.seeds)), args.out,
-        workers=args.workers, figures=not args.no_figures, progress=not args.quiet,
-    )
+    try:
+        # makes each planner once before the workers fork: the MPC's solver is generated here if needed
+        result = evaluate(
+            scenarios, planners, list(range(args.first_seed, args.first_seed + args.seeds)), args.out,
+            workers=args.workers, figures=not args.no_figures, progress=not args.quiet, config=config,
+        )
+    except SolverDirError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
     print(markdown_table(result.summary))
     print(f"tables and figures in {result.out_dir}")
     return 0
@@ -82,20 +135,35 @@ _RECORDED_SEEDS = (f"the recorded scenes ({', '.join(RECORDED_SCENARIOS)}) have 
                    "one per crossing")
 
 
+def add_solver_options(p: argparse.ArgumentParser) -> None:
+    """``--spec FILE`` and ``--solver-dir DIR``: the solver of the MPC planners."""
+    g = p.add_argument_group("the MPC planners' solver (default: the built-in default spec's, generated and built "
+                             f"into the tools' cache, {CACHE_DIR}/, when it is not there yet)")
+    g.add_argument("--spec", type=Path, metavar="FILE",
+                   help=f"YAML spec: its solver is generated and built into {CACHE_DIR}/<name>-<hash>/ and reused "
+                   "while the spec is unchanged; no other folder is written")
+    g.add_argument("--solver-dir", type=Path, metavar="DIR",
+                   help="an already generated and built solver package (humanmpc-gen generate + build), used as it "
+                   "is: never regenerated or rebuilt; with --spec it must hold that spec's solver")
+
+
 def add_simulate_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """``simulate --scenario NAME --planner NAME --seed S [--plot FILE] [--animate FILE.gif]``."""
+    """``simulate --scenario NAME --planner NAME --seed S [--plot FILE] [--animate FILE.gif] [--spec FILE]
+    [--solver-dir DIR]``."""
     p = subparsers.add_parser("simulate", help="run one closed-loop episode and print its metrics")
     p.add_argument("--scenario", required=True, help=f"one of: {', '.join(sorted(SCENARIOS))}")
     p.add_argument("--planner", required=True, help=f"a registered planner (now: {', '.join(planner_names())})")
     p.add_argument("--seed", type=non_negative_int, default=0, help=f"scenario seed (default 0); {_RECORDED_SEEDS}")
     p.add_argument("--plot", type=Path, help="write the paths figure to this file (.png/.svg/.pdf)")
     p.add_argument("--animate", type=Path, help="write an animated GIF of the episode to this file")
+    add_solver_options(p)
     p.set_defaults(func=_simulate)
     return p
 
 
 def add_evaluate_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """``evaluate [--scenarios ...] [--planners ...] [--seeds N] [--workers W] [--out DIR]``."""
+    """``evaluate [--scenarios ...] [--planners ...] [--seeds N] [--workers W] [--out DIR] [--spec FILE]
+    [--solver-dir DIR]``."""
     p = subparsers.add_parser("evaluate", help="run scenarios x planners x seeds and tabulate the metrics")
     p.add_argument("--scenarios", nargs="+", help=f"any of {', '.join(sorted(SCENARIOS))}; default: the simulated "
                    f"ones, {', '.join(SIMULATED_SCENARIOS)}")
@@ -107,6 +175,7 @@ def add_evaluate_parser(subparsers: argparse._SubParsersAction) -> argparse.Argu
     p.add_argument("--out", type=Path, default=Path("out/evaluation"), help="output folder (default out/evaluation)")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_solver_options(p)
     p.set_defaults(func=_evaluate)
     return p
 
@@ -117,22 +186,29 @@ def _demo(args: argparse.Namespace) -> int:
 
     try:
         make_scenario(args.scenario, args.seed)  # a wrong name or seed is told before the solver is built
+        config = choose_solver(args.spec, args.solver_dir)
     except ValueError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
-    run_demo(seed=args.seed, out_dir=args.out, scenario_name=args.scenario)
+    try:
+        run_demo(seed=args.seed, out_dir=args.out, scenario_name=args.scenario, config=config)
+    except SolverDirError as err:  # raised by its first step, before any episode
+        print(f"error: {err}", file=sys.stderr)
+        return 2
     return 0
 
 
 def add_demo_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """``demo [--scenario NAME] [--seed S] [--out DIR]``: what ``make demo`` runs."""
+    """``demo [--scenario NAME] [--seed S] [--out DIR] [--spec FILE | --solver-dir DIR]``: what ``make demo`` runs."""
     p = subparsers.add_parser("demo", help="the main job: both planners in the crossing-group scenario",
-                              description="Generate the default solver, run the crossing-group scenario with the MPC "
-                              "and the DWB baseline, print their metrics side by side and the timing summary, "
-                              "and write the figure.")
+                              description="Generate and build the default solver (or that of --spec) into the "
+                              f"tools' cache ({CACHE_DIR}/) when it is not there yet, run the crossing-group "
+                              "scenario (or --scenario) with the MPC and the DWB baseline, print their metrics side "
+                              "by side and the timing summary, and write the figure.")
     p.add_argument("--scenario", default="crossing_group",
                    help=f"the scenario (default crossing_group); one of: {', '.join(sorted(SCENARIOS))}")
     p.add_argument("--seed", type=non_negative_int, default=0, help=f"scenario seed (default 0); {_RECORDED_SEEDS}")
     p.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
+    add_solver_options(p)
     p.set_defaults(func=_demo)
     return p

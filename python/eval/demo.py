@@ -1,9 +1,11 @@
 """The main job (make demo): the paper's "crossing group" scenario with the MPC and the DWB baseline
 (any other registered scenario by name, e.g. a recorded crowd).
 
-Generates and builds the default solver when needed, runs the planners on the same seeded scenario
-(the MPC in the evaluation's configuration and in the paper's, docs/evaluation.md, and the DWB),
-prints their metrics side by side and a timing summary, and writes the figure.
+Takes the MPC planners' solver chosen for this process (``humanmpc.planners.solver_dir``: by default the
+built-in default spec's, generated and built into the tools' cache when it is not there yet), runs the
+planners on the same seeded scenario (the MPC in the evaluation's configuration and in the paper's,
+docs/evaluation.md, and the DWB), prints their metrics side by side and a timing summary, and writes
+the figure.
 """
 
 from __future__ import annotations
@@ -15,10 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..planners.mpc import ensure_solver
 from ..planners.registry import make_planner
+from ..planners.solver_dir import ensure_solver
 from ..sim.scenarios import make_scenario
-from .episode import EpisodeLog, run_episode
+from .episode import EpisodeConfig, EpisodeLog, run_episode
 from .metrics import compute_metrics
 from .plots import plot_episodes
 
@@ -54,7 +56,9 @@ def timing_summary(logs: dict[str, EpisodeLog]) -> str:
     return "\n".join(lines)
 
 
-def run_demo(seed: int = 0, out_dir: Path = Path("out/demo"), scenario_name: str = SCENARIO) -> Path:
+def run_demo(seed: int = 0, out_dir: Path = Path("out/demo"), scenario_name: str = SCENARIO,
+             config: EpisodeConfig | None = None) -> Path:
+    """The demo with the chosen solver; ``config``: the episodes' settings (its horizon the solver's N)."""
     say = lambda m: print(m, file=sys.stderr)  # noqa: E731
     started = time.perf_counter()
     scenario = make_scenario(scenario_name, seed)  # a wrong name or seed fails before the solver is built
@@ -64,7 +68,7 @@ def run_demo(seed: int = 0, out_dir: Path = Path("out/demo"), scenario_name: str
     for name in PLANNERS:
         planner = make_planner(name)
         say(f"[demo] {scenario_name} seed {seed}: running {name} ...")
-        logs[name] = run_episode(scenario, planner)
+        logs[name] = run_episode(scenario, planner, config)
     rows = {name: compute_metrics(log).as_row() for name, log in logs.items()}
     print(f"\n{scenario_name}, seed {seed}: HuMAN-MPC (generated C, SQP-RTI) vs the DWB baseline")
     print("mpc: the evaluation's configuration (global-path carrot, loop restart, exact-Hessian RTI, "

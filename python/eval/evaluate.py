@@ -18,6 +18,7 @@ import math
 import multiprocessing as mp
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -32,8 +33,8 @@ from .plots import plot_episodes
 SUMMARY_COLUMNS = [
     "success", "collisions", "robot_fault_contacts", "person_fault_contacts", "timeout", "time_to_goal",
     "path_length", "min_human_distance", "time_within_dth", "time_intimate", "time_personal", "protective_stops",
-    "stop_time", "freezing_time", "path_irregularity", "mean_jerk", "planner_ms_mean", "planner_ms_p99",
-    "planner_ms_max",
+    "stop_time", "freezing_time", "path_irregularity", "mean_jerk", "omega_flip_rate", "planner_ms_mean",
+    "planner_ms_p99", "planner_ms_max",
 ]
 
 
@@ -55,10 +56,6 @@ def run_job(job: Job, config: EpisodeConfig | None = None) -> tuple[Row, Episode
     row: Row = {"scenario": job.scenario, "planner": job.planner, "seed": job.seed}
     row.update(compute_metrics(log).as_row())
     return row, (log if job.keep_log else None)
-
-
-def _run_job_plain(job: Job) -> tuple[Row, EpisodeLog | None]:
-    return run_job(job)
 
 
 def validate_names(scenarios: Sequence[str], planners: Sequence[str], seeds: Sequence[int] = ()) -> None:
@@ -165,15 +162,17 @@ def evaluate(
     workers: int = 2,
     figures: bool = True,
     progress: bool = True,
+    config: EpisodeConfig | None = None,
 ) -> EvaluationResult:
-    """Run every combination, write the tables (and figures) and return them."""
+    """Run every combination, write the tables (and figures) and return them; ``config``: the episodes'
+    settings (default ``EpisodeConfig()``; its horizon must be the MPC solver's N)."""
     validate_names(scenarios, planners, seeds)
     if not seeds:
         raise ValueError("evaluate needs at least one seed")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     # One instance of each planner here, before the workers fork: one-time setup (the MPC generates
-    # and builds its solver when missing) must not run in two workers at once.
+    # and builds its solver into the cache when missing) must not run in two workers at once.
     for name in planners:
         make_planner(name)
     first = seeds[0]
@@ -182,13 +181,14 @@ def evaluate(
     bar = tqdm(total=len(jobs), desc="episodes", disable=not progress)
     if workers <= 1:
         for job in jobs:
-            results.append(run_job(job))
+            results.append(run_job(job, config))
             bar.update()
     else:
-        # fork: the workers inherit planners registered at run time (e.g. "mpc").
+        # fork: the workers inherit planners registered at run time and the solver chosen for the MPC
+        # planners (humanmpc.planners.solver_dir.select_solver).
         ctx = mp.get_context("fork")
         with ctx.Pool(workers) as pool:
-            for res in pool.imap_unordered(_run_job_plain, jobs):
+            for res in pool.imap_unordered(partial(run_job, config=config), jobs):
                 results.append(res)
                 bar.update()
     bar.close()

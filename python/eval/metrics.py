@@ -36,6 +36,9 @@ Definitions (distances to humans are centre-to-centre, robot centre to human cen
   the goal, where the direction is undefined, is skipped);
 * jerk (SocNavBench "average jerk"): the mean norm of the third finite difference of the
   robot positions divided by dt^3 (m/s^3);
+* turn-rate flips: the fraction of control steps whose applied turn rate omega differs from the
+  previous step's by more than 2 rad/s (``omega_flip_rate``, 0..1; the first step has no previous
+  one and counts as no flip); a Gauss-Newton RTI far from its goal throws omega between its bounds;
 * planner time: mean, 99th percentile (linear interpolation) and maximum of the per-step
   planner time in ms.
 """
@@ -59,6 +62,7 @@ D_TH = 1.0
 MOVING_SPEED = 0.05  # m/s: above it the robot moves (contact attribution)
 FREEZE_TIME = 5.0  # s without progress that make a freezing event
 FREEZE_PROGRESS = 0.1  # m closer to the goal that make progress
+OMEGA_FLIP = 2.0  # rad/s: a larger change of the turn rate between two steps is a flip
 
 
 @dataclass(frozen=True)
@@ -86,6 +90,7 @@ class EpisodeMetrics:
     freezing_time: float
     path_irregularity: float
     mean_jerk: float
+    omega_flip_rate: float
     planner_ms_mean: float
     planner_ms_p99: float
     planner_ms_max: float
@@ -207,6 +212,14 @@ def mean_jerk(positions: FloatArray, dt: float) -> float:
     return float(np.mean(np.linalg.norm(jerk, axis=1)))
 
 
+def omega_flip_rate(controls: FloatArray) -> float:
+    """Fraction of the steps (rows of (a, omega) controls) whose omega jumps by more than OMEGA_FLIP."""
+    if controls.shape[0] == 0:
+        return 0.0
+    flips = np.abs(np.diff(controls[:, 1])) > OMEGA_FLIP
+    return float(np.count_nonzero(flips)) / controls.shape[0]
+
+
 def timing_stats(solve_ms: FloatArray) -> tuple[float, float, float]:
     if solve_ms.size == 0:
         return (float("nan"),) * 3
@@ -256,6 +269,7 @@ def compute_metrics(log: EpisodeLog) -> EpisodeMetrics:
         freezing_time=freezing_time,
         path_irregularity=path_irregularity(log.states, log.goal[:2]),
         mean_jerk=mean_jerk(xy, log.dt),
+        omega_flip_rate=omega_flip_rate(log.controls),
         planner_ms_mean=mean_ms,
         planner_ms_p99=p99_ms,
         planner_ms_max=max_ms,

@@ -21,36 +21,21 @@ limit, no recovery) and only the goal pose.
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Mapping
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..bindings import load
-from ..codegen.build import build, is_stale
-from ..codegen.generate import MANIFEST, generate
 from ..codegen.params import PARAMS
-from ..codegen.spec import Spec
 from ..controller import Controller
+from ..results import ControllerResult
 from ..sim.sensors import ObstacleSensor
+from ..solver import Solver
 from .global_path import GlobalPlanner, GridConfig
 from .interface import Observation, PlanResult
-
-DEFAULT_SOLVER_DIR = Path("generated") / "paper"  # as humanmpc-gen generate writes it, in the working folder
-
-
-def ensure_solver(solver_dir: Path = DEFAULT_SOLVER_DIR, spec: Spec | None = None) -> Path:
-    """The solver of ``spec`` (default: the built-in spec) in solver_dir, generated and built if needed."""
-    spec = spec or Spec()
-    manifest = solver_dir / MANIFEST
-    current = manifest.is_file() and f'"spec_hash": "{spec.digest()}"' in manifest.read_text()
-    if not current:
-        generate(spec, solver_dir, force=manifest.is_file(), log=lambda m: print(m, file=sys.stderr))
-    if is_stale(solver_dir):
-        build(solver_dir, log=lambda m: print(m, file=sys.stderr))
-    return solver_dir
+from .solver_dir import DEFAULT_SOLVER_DIR as DEFAULT_SOLVER_DIR  # moved to solver_dir, re-exported here
+from .solver_dir import ensure_solver as ensure_solver
 
 
 def paper_params() -> dict[str, Any]:
@@ -63,10 +48,15 @@ class MPCPlanner:
 
     name = "mpc"
 
-    def __init__(self, controller: Controller | None = None, *, params: Mapping[str, Any] | None = None,
+    def __init__(self, controller: Controller | Solver | None = None, *, params: Mapping[str, Any] | None = None,
                  global_path: bool = True, grid: GridConfig | None = None, replan_period: float = 1.0,
                  name: str | None = None) -> None:
-        self.controller = controller or load(ensure_solver()).controller()
+        """``controller``: a controller, or a loaded solver package to make one from (kept as ``solver``, so
+        the tools can name the package that runs), or None for the process's chosen solver (solver_dir)."""
+        if controller is None:
+            controller = load(ensure_solver(), build_if_needed=False)
+        self.solver: Solver | None = controller if isinstance(controller, Solver) else None
+        self.controller = controller.controller() if isinstance(controller, Solver) else controller
         if params:
             self.controller.set_params(**dict(params))
         if name is not None:
@@ -76,9 +66,10 @@ class MPCPlanner:
         self._sensor: ObstacleSensor | None = None
         self._omega = 0.0
         self.recoveries = 0  # recovery SQPs in this episode (loops and stalls)
+        self.last: ControllerResult | None = None  # the controller's last result, all of it
 
     @staticmethod
-    def paper(controller: Controller | None = None, name: str = "mpc_paper") -> MPCPlanner:
+    def paper(controller: Controller | Solver | None = None, name: str = "mpc_paper") -> MPCPlanner:
         """The paper's configuration: its parameters, the goal pose alone."""
         return MPCPlanner(controller, params=paper_params(), global_path=False, name=name)
 
@@ -88,6 +79,7 @@ class MPCPlanner:
         self._sensor = None
         self._omega = 0.0
         self.recoveries = 0
+        self.last = None
 
     def _path(self, obs: Observation) -> np.ndarray | None:
         if not self.global_path:
@@ -107,8 +99,8 @@ class MPCPlanner:
         if obs.humans_pred.shape[0] != ctl.dims.N + 1 or abs(obs.dt - ctl.dims.dt) > 1e-9:
             raise ValueError(f"the episode predicts {obs.humans_pred.shape[0] - 1} intervals of {obs.dt} s; "
                              f"the controller needs {ctl.dims.N} of {ctl.dims.dt} s (EpisodeConfig(horizon, dt))")
-        if abs(float(obs.goal[3]) - ctl.params["v_ref"]) > 1e-12:
-            ctl.set_params(v_ref=float(obs.goal[3]))
+        if abs(float(obs.goal[3]) - ctl.params["v_ref"]) > 1e-12:  # the episode's cruising speed, DWB's cap too
+            ctl.set_params(v_ref=float(obs.goal[3]), speed_limit=float(obs.goal[3]))
         if self._sensor is None or self._sensor.world is not obs.world:
             self._sensor = ObstacleSensor(obs.world, max_points=ctl.max_obstacle_points)
         people = obs.humans_now
@@ -119,6 +111,7 @@ class MPCPlanner:
         tracks = np.hstack([people[keep], obs.humans_velocity[keep]])
         r = ctl.step(obs.time, pose=obs.x[:3], v=float(obs.x[3]), omega=self._omega, path=self._path(obs),
                      goal=obs.goal[:3], people=tracks, ids=keep, obstacles=self._sensor.points(obs.x[:2]))
+        self.last = r
         self._omega = float(r.command[1])
         self.recoveries += int(r.recovered)
         reason = r.reason if r.stop else ("stalled" if r.stalled else None)

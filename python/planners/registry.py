@@ -6,14 +6,25 @@ generated C controller as ``"mpc"`` (the spec's defaults) and ``"mpc_paper"`` (t
 the goal pose alone; :meth:`~humanmpc.planners.mpc.MPCPlanner.paper`).
 Evaluation workers are forked from the registering process, so registrations made before an
 evaluation starts are visible in the workers.
+
+The two MPC planners load the solver chosen for this process by
+:func:`~humanmpc.planners.solver_dir.select_solver` (re-exported here; the ``simulate``, ``evaluate``
+and ``demo`` commands call it with their ``--spec`` / ``--solver-dir`` before any planner is made, and
+forked workers inherit the choice); without a choice, the built-in default spec's solver in the
+tools' cache. A factory registered for another MPC configuration honours the choice by loading
+``ensure_solver()``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
+from ..bindings import load
+from ..solver import Solver
 from .dwb import DWBPlanner
 from .interface import Planner
+from .solver_dir import ensure_solver
+from .solver_dir import select_solver as select_solver
 
 PlannerFactory = Callable[[], Planner]
 
@@ -42,17 +53,21 @@ def make_planner(name: str) -> Planner:
     return factory()
 
 
+def _selected_solver() -> Solver:
+    """The chosen solver (select_solver), generated and built into the cache first when it is the tools'."""
+    return load(ensure_solver(), build_if_needed=False)
+
+
 def _make_mpc() -> Planner:
-    # Imported here: loading the MPC generates and builds its solver when that is missing.
     from .mpc import MPCPlanner
 
-    return MPCPlanner(name="mpc")
+    return MPCPlanner(_selected_solver(), name="mpc")
 
 
 def _make_mpc_paper() -> Planner:
     from .mpc import MPCPlanner
 
-    return MPCPlanner.paper(name="mpc_paper")
+    return MPCPlanner.paper(_selected_solver(), name="mpc_paper")
 
 
 register_planner("dwb", DWBPlanner)
