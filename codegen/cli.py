@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import ctypes
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -33,6 +34,30 @@ def _cmd_build(args: argparse.Namespace) -> int:
     return 0
 
 
+def static_memory(lib: Path, name: str) -> list[tuple[str, int]]:
+    """(what, bytes) of the solver's and the controller's structs, as the built library reports them."""
+    c = ctypes.CDLL(str(lib.resolve()))
+    sizes = [ctypes.c_size_t() for _ in range(5)]
+
+    def call(fn: str, *args: object) -> int:
+        f = getattr(c, f"{name}_{fn}")
+        f.restype = ctypes.c_size_t if fn.endswith("memsize") else ctypes.c_int
+        return int(f(*args))
+
+    solver = call("solver_memsize")
+    controller = call("controller_memsize")
+    call("struct_sizes", *(ctypes.byref(x) for x in sizes[:3]))
+    call("controller_struct_sizes", *(ctypes.byref(x) for x in sizes[3:]))
+    return [
+        (f"{name}_solver", solver),
+        (f"{name}_controller (holds its solver)", controller),
+        (f"{name}_params", sizes[0].value),
+        (f"{name}_input / {name}_output", sizes[1].value + sizes[2].value),
+        (f"{name}_controller_input", sizes[3].value),
+        (f"{name}_controller_output", sizes[4].value),
+    ]
+
+
 def _cmd_info(args: argparse.Namespace) -> int:
     d: Path = args.dir
     m = read_manifest(d)
@@ -48,6 +73,10 @@ def _cmd_info(args: argparse.Namespace) -> int:
             print(f"    {p.relative_to(d)!s:<28} {p.stat().st_size:>9,} B")
     lib = d / str(m["library"])
     print(f"  library      {lib} ({lib.stat().st_size:,} B)" if lib.exists() else "  library      not built")
+    if lib.exists():
+        print("  static memory (the structs a caller declares; nothing is allocated at run time)")
+        for what, size in static_memory(lib, str(m["name"])):
+            print(f"    {what:<34} {size:>11,} B")
     functions = m["functions"]
     assert isinstance(functions, list)
     print("  model functions (C and Python)")

@@ -248,10 +248,13 @@ class Monitor:
     deadline_ms: float = param("monitor.deadline_ms")
 
 
+_DEFAULT_MAX_TRACKS = 32  # M, tracked people per controller step, unless humans.max is larger
+
+
 @dataclass(frozen=True)
 class Controller:
-    max_tracks: int = integer(32, "M: tracked people the controller takes per step (a fixed size, >= humans.max)",
-                              ge=1, le=1000)
+    max_tracks: int = integer(_DEFAULT_MAX_TRACKS, "M: tracked people the controller takes per step (a fixed size, "
+                              ">= humans.max; default 32, or humans.max when larger)", ge=1, le=1000)
     max_path_points: int = integer(256, "P: waypoints of the reference path (a fixed size)", ge=2, le=100_000)
     max_obstacle_points: int = integer(256, "K: obstacle points (a scan's or a costmap's) per step (a fixed size)",
                                        ge=1, le=100_000)
@@ -415,6 +418,11 @@ def resolve_spec(data: Any, source: str = "spec") -> Spec:
     problems: list[str] = []
     if isinstance(data, Mapping) and data.get("preset") == "paper":
         data = _with_defaults(data, paper_values())
+    humans = data.get("humans") if isinstance(data, Mapping) else None
+    if isinstance(humans, Mapping) and isinstance(humans.get("max"), int) and humans["max"] > _DEFAULT_MAX_TRACKS:
+        # The controller takes at least the solver's N_h tracks: a larger N_h raises the default M with it
+        # (an M given below N_h is still an error).
+        data = _with_defaults(data, {"controller.max_tracks": humans["max"]})
     spec = _resolve_section(Spec, data, "", problems)
     if not problems:
         problems = _cross_checks(spec)

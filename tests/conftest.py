@@ -28,8 +28,15 @@ def make_solver(root: Path, data: dict | None = None, *, built: bool = True) -> 
 
 @pytest.fixture(scope="session")
 def paper_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The built-in default spec (the paper's values), generated and built."""
-    return make_solver(tmp_path_factory.mktemp("paper"))
+    """The paper's configuration (``preset: paper``: its weights, Gauss-Newton, no controller extras),
+    generated and built: the solver tests' reference configuration."""
+    return make_solver(tmp_path_factory.mktemp("paper"), {"preset": "paper"})
+
+
+@pytest.fixture(scope="session")
+def default_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The built-in default spec (the values that won the evaluation), generated and built."""
+    return make_solver(tmp_path_factory.mktemp("default"))
 
 
 @pytest.fixture(scope="session")

@@ -27,8 +27,8 @@ People = Callable[[float], np.ndarray]  # time -> (k, 4) tracks [x, y, vx, vy]
 
 
 @pytest.fixture()
-def ctl(paper_dir: Path) -> Controller:
-    return humanmpc.load(paper_dir).controller()
+def ctl(default_dir: Path) -> Controller:
+    return humanmpc.load(default_dir).controller()
 
 
 def walking(*tracks: tuple[float, float, float, float]) -> People:

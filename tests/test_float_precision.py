@@ -25,7 +25,7 @@ from .conftest import make_solver, require_tool
 from .test_firmware import FLOAT_U0_MEDIAN_TOL, FLOAT_U0_TOL
 
 DOUBLE_MATH = {"sin", "cos", "tan", "sincos", "exp", "log", "sqrt", "pow", "fabs", "fmax", "fmin", "atan2", "tanh"}
-FLOAT_SPEC = {"precision": "float"}  # the paper spec otherwise, qp_tol 1e-6 included
+FLOAT_SPEC = {"preset": "paper", "precision": "float"}  # the paper spec otherwise, qp_tol 1e-6 included
 
 
 @pytest.fixture(scope="session")
@@ -36,7 +36,7 @@ def float_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="session")
 def pair(float_root: Path) -> tuple[humanmpc.Solver, humanmpc.Solver]:
     """(double, float) solvers of the paper's spec."""
-    d = make_solver(float_root, {"name": "pd"})
+    d = make_solver(float_root, {"preset": "paper", "name": "pd"})
     f = make_solver(float_root, {"name": "pf", **FLOAT_SPEC})
     return humanmpc.load(d), humanmpc.load(f)
 
@@ -151,8 +151,8 @@ def test_float_host_makes_the_doubles_stop_decisions_on_warm_replays(float_root:
     without the QP warm start. Any other decision (the monitor's input checks, a human already within
     d_h, a failed QP) must agree at every step, and the plan check in all but one step per replay."""
     ls = {"line_search": True, "qp_tol": 10 * FLOAT_MIN_QP_TOL}
-    dbl = humanmpc.load(make_solver(float_root, {"name": "lsd", "solver": ls}))
-    flt = humanmpc.load(make_solver(float_root, {"name": "lsf", "precision": "float", "solver": ls}))
+    dbl = humanmpc.load(make_solver(float_root, {"preset": "paper", "name": "lsd", "solver": ls}))
+    flt = humanmpc.load(make_solver(float_root, {"preset": "paper", "name": "lsf", "precision": "float", "solver": ls}))
     unsafe_plan = 7
     for nh_seed in (0, 1, 2):
         replay = fw.record_replay(dbl, steps=60, seed=nh_seed)

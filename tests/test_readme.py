@@ -7,7 +7,6 @@ from pathlib import Path
 
 import yaml
 
-import humanmpc
 from humanmpc.codegen.spec import Spec, resolve_spec
 
 README = Path(__file__).resolve().parent.parent / "README.md"
@@ -22,8 +21,11 @@ def test_readme_spec_is_the_default_spec() -> None:
     assert resolve_spec(yaml.safe_load(spec_text)) == Spec()
 
 
-def test_readme_python_example_runs(paper: humanmpc.Solver, paper_dir: Path, capsys) -> None:  # type: ignore[no-untyped-def]
-    (code,) = blocks("python")
-    exec(compile(code.replace('"generated/paper"', repr(str(paper_dir))), "README.md", "exec"), {})
+def test_readme_python_examples_run(default_dir: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    """The solver's example, then the controller's (which reuses its imports), on the default spec."""
+    solver_code, controller_code = blocks("python")
+    code = (solver_code + controller_code).replace('"generated/paper"', repr(str(default_dir)))
+    exec(compile(code, "README.md", "exec"), {})
     out = capsys.readouterr().out
     assert "Dims(nx=4, nu=2, N=50, nh=10, ng=11" in out
+    assert "following" in out and "(51, 4)" in out  # the controller's outcome and plan

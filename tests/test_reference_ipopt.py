@@ -59,7 +59,7 @@ def indep_params(spec: Spec) -> indep.Params:
 def test_hand_assembled_derivatives_equal_casadi_ad() -> None:
     """Gradient, Jacobian and exact Hessian of the Lagrangian (assembled node by node, at their
     patterns) against CasADi's AD of the whole NLP, at random points and multipliers."""
-    spec = resolve_spec({"humans": {"max": 4}, "horizon": {"N": 6, "T": 0.6}})
+    spec = resolve_spec({"preset": "paper", "humans": {"max": 4}, "horizon": {"N": 6, "T": 0.6}})
     nlp = ReferenceNlp(spec)
     rng = np.random.default_rng(3)
     W = ca.MX.sym("w", nlp.nw)
@@ -88,7 +88,8 @@ def test_hand_assembled_derivatives_equal_casadi_ad() -> None:
 def test_objective_equals_the_independent_formulation() -> None:
     """plan_cost (our NLP's objective, slack at its minimum) equals tests/nlp_reference.objective,
     written independently of codegen/, on random trajectories."""
-    spec = resolve_spec({"humans": {"max": 3}, "horizon": {"N": 8, "T": 0.8}, "obstacle": {"d_s": 1.5}})
+    spec = resolve_spec({"preset": "paper", "humans": {"max": 3}, "horizon": {"N": 8, "T": 0.8},
+                         "obstacle": {"d_s": 1.5}})
     nlp = ReferenceNlp(spec)
     pr = indep_params(spec)
     rng = np.random.default_rng(5)
@@ -104,7 +105,7 @@ def test_objective_equals_the_independent_formulation() -> None:
 
 
 def test_bounds_switch_rows_off_for_absent_humans_and_obstacle() -> None:
-    spec = resolve_spec({"humans": {"max": 3}, "horizon": {"N": 4, "T": 0.4}})
+    spec = resolve_spec({"preset": "paper", "humans": {"max": 3}, "horizon": {"N": 4, "T": 0.4}})
     nlp = ReferenceNlp(spec)
     scene = random_scene(np.random.default_rng(0), 4, 1, obstacle=False)
     lbw, ubw, lbg, ubg = (np.array(v).ravel() for v in nlp.bounds(nlp.params.pack(**scene,
@@ -133,7 +134,7 @@ def ipopt_ok() -> None:
 @pytest.fixture(scope="module")
 def ref30(tmp_path_factory: pytest.TempPathFactory, ipopt_ok: None) -> IpoptReference:
     """The paper's spec with N_h = 30 (N = 50)."""
-    spec = resolve_spec({"humans": {"max": 30}})
+    spec = resolve_spec({"preset": "paper", "humans": {"max": 30}})
     return build_ipopt_reference(spec, tmp_path_factory.mktemp("ipopt30"))
 
 
@@ -173,7 +174,7 @@ def test_c_ipopt_optimum_satisfies_the_independent_reference(ref30: IpoptReferen
 
 
 def test_warm_start_reaches_the_cold_optimum_with_fewer_iterations(tmp_path: Path, ipopt_ok: None) -> None:
-    spec = resolve_spec({"humans": {"max": 2}, "horizon": {"N": 20, "T": 2.0}})
+    spec = resolve_spec({"preset": "paper", "humans": {"max": 2}, "horizon": {"N": 20, "T": 2.0}})
     replay = synthetic_replay(spec, 2, 8, seed=4)
     ref = build_ipopt_reference(spec, tmp_path / "ip")
     cold, warm = ref.run(replay, tol=1e-10), ref.run(replay, warm=True, tol=1e-10)
@@ -205,7 +206,7 @@ def test_failures_are_reported_with_ipopt_status(ref30: IpoptReference) -> None:
 
 
 def test_a_replay_of_another_spec_is_refused(ref30: IpoptReference, tmp_path: Path) -> None:
-    other = resolve_spec({"humans": {"max": 30}, "weights": {"goal": [1.0, 1.0, 0.0, 250.0]}})
+    other = resolve_spec({"preset": "paper", "humans": {"max": 30}, "weights": {"goal": [1.0, 1.0, 0.0, 250.0]}})
     replay = Replay.from_steps([random_scene(np.random.default_rng(0), 50, 3)], other)
     with pytest.raises(ReplayError, match="recorded for spec"):
         ref30.run(replay)
@@ -240,7 +241,7 @@ def test_generated_c_is_warning_free(ref30: IpoptReference, tmp_path: Path) -> N
 
 
 def test_zero_humans_spec_builds_and_solves(tmp_path: Path, ipopt_ok: None) -> None:
-    spec = resolve_spec({"name": "nobody", "humans": {"max": 0}, "horizon": {"N": 20, "T": 2.0}})
+    spec = resolve_spec({"preset": "paper", "name": "nobody", "humans": {"max": 0}, "horizon": {"N": 20, "T": 2.0}})
     ref = build_ipopt_reference(spec, tmp_path / "ip0")
     replay = Replay.from_steps([{"x0": [0, 0, 0, 0], "goal": [3, 1, 0, 0.8], "humans_now": None,
                                  "humans_pred": None, "obstacle": [1.5, 0.3]}], spec)

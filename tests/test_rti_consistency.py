@@ -15,7 +15,7 @@ from .conftest import make_solver
 
 @pytest.fixture(scope="module")
 def rti_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return make_solver(tmp_path_factory.mktemp("rti"), {"name": "rti", "humans": {"max": 2}})
+    return make_solver(tmp_path_factory.mktemp("rti"), {"preset": "paper", "name": "rti", "humans": {"max": 2}})
 
 
 def scene(t: int, n: int) -> dict:

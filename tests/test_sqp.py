@@ -20,7 +20,7 @@ D_H = 0.5
 @pytest.fixture(scope="module")
 def crowd30(tmp_path_factory: pytest.TempPathFactory) -> humanmpc.Solver:
     """The paper's spec with N_h = 30 (the largest crowd of the paper's scalability experiment)."""
-    d = make_solver(tmp_path_factory.mktemp("crowd30"), {"name": "crowd30", "humans": {"max": 30}})
+    d = make_solver(tmp_path_factory.mktemp("crowd30"), {"preset": "paper", "name": "crowd30", "humans": {"max": 30}})
     return humanmpc.load(d)
 
 

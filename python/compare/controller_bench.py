@@ -101,8 +101,8 @@ def bench_controller(ctl: Controller, tracks: int, seeds: int, steps: int) -> Co
     own = step - solver - recovery
     outcomes = Counter(OUTCOME_NAMES.get(int(o), str(o)) for o in s["outcome"])
     return ControllerBenchResult(
-        tracks=tracks, nh=ctl.dims.nh, steps=step.size, seeds=seeds, step_ms=TimingStats.of(step),
-        solver_ms=TimingStats.of(solver), own_ms=TimingStats.of(own),
+        tracks=tracks, nh=ctl.dims.nh, steps=step.size, seeds=seeds, step_ms=TimingStats.of(s["step"]),
+        solver_ms=TimingStats.of(s["solver"]), own_ms=TimingStats.of(own.tolist()),
         recovery_steps=int(np.count_nonzero(recovery > 0)), recovery_ms_max=float(recovery.max()),
         own_share=float(own.sum() / step.sum()) if step.sum() > 0 else 0.0, outcomes=dict(outcomes),
         min_human_distance=float(min(s["dist"])),
