@@ -282,11 +282,12 @@ def test_controller_parameters_are_checked_by_their_rules(ctl: Controller) -> No
 
 def test_a_loop_after_the_goal_jumps_behind_is_replaced_by_a_recovery_plan(ctl: Controller) -> None:
     """Cruising at 0.8 m/s with the goal 10 m ahead, the goal jumps 10 m behind: with the paper's speed
-    weight (250) the real-time iterations continue the forward plan into a loop; the recovery replaces
-    it by a cold SQP plan, so no plan handed out is a loop."""
+    weight (250, and its free turn rate) the real-time iterations continue the forward plan into a loop;
+    the recovery replaces it by a cold SQP plan, so no plan handed out is a loop."""
     def loops(recovery: int) -> tuple[int, int]:
         ctl.reset()
-        ctl.set_params(w_goal=(0.5, 0.5, 0.0, 250.0), approach=0, recovery_iterations=recovery)
+        ctl.set_params(w_goal=(0.5, 0.5, 0.0, 250.0), w_control=(0.0, 0.0), approach=0,
+                       recovery_iterations=recovery)
         x, out, recovered = np.array([0.0, 0.0, 0.0, 0.8]), 0, 0
         for k in range(30):
             goal = (x[0] + 10.0, 0.0, 0.0) if k < 20 else (x[0] - 10.0, x[1], np.pi)

@@ -108,7 +108,7 @@ def test_generated_folder_builds_on_its_own_with_make(paper_dir: Path, tmp_path:
 def test_header_records_generator_version_and_spec_hash(paper_dir: Path) -> None:
     header = (paper_dir / "paper.h").read_text()
     assert f'#define PAPER_GENERATOR_VERSION "{humanmpc.__version__}"' in header
-    assert f'#define PAPER_SPEC_HASH "{Spec().digest()}"' in header
+    assert f'#define PAPER_SPEC_HASH "{Spec.paper().digest()}"' in header
 
 
 def test_failure_during_generation_leaves_nothing_behind(tmp_path: Path) -> None:
