@@ -313,6 +313,12 @@ def ctl_m4f(tools: None, ctl_float_dir: Path, ctl_replay: fc.ControllerReplay, f
             for mode in ("warm", "cold")}
 
 
+@pytest.fixture(scope="session")
+def ctl_m7_float(tools: None, ctl_float_dir: Path, ctl_replay: fc.ControllerReplay, fw_root: Path,
+                 ctl_m4f: dict[str, CtlResult]) -> CtlResult:
+    return _controller_firmware(ctl_float_dir, "cortex-m7", ctl_replay, False, fw_root)
+
+
 def _human_stops(steps: list) -> list[bool]:
     return [int(s.stop_reason) == StopReason.HUMAN_TOO_CLOSE for s in steps]
 
@@ -362,6 +368,19 @@ def test_m7_double_controller_commands_equal_the_hosts_to_1e12_typically_and_to_
         assert dc.max() <= tol and du.max() <= tol, f"{mode}: period {int(du.argmax())}: |u diff| {du.max():.3g}"
         assert dg.max() <= 1e-9, f"{mode}: the carrot differs"  # geometry only: no solver in between
         assert dc[0] == 0.0 and du[0] == 0.0, "the first period, from the same cold start, is bit-equal"
+
+
+def test_m7_float_controller_is_bit_equal_to_the_float_host_where_the_math_libraries_agree(
+        ctl_m7_float: CtlResult) -> None:
+    """The Cortex-M7 multilib links the same single-precision sinf/cosf/expf as glibc: with the math
+    library out of the way, every period of the warm replay is the host's, bit for bit, so what
+    separates the double builds above is the math library alone."""
+    r = ctl_m7_float
+    assert r.run.real == "float" and len(r.run.steps) == CTL_STEPS
+    assert r.agree.same_decisions and r.agree.people_mismatches == 0
+    assert r.agree.max_command_diff == 0.0 and r.agree.max_u_diff == 0.0
+    for s, h in zip(r.run.steps, r.host, strict=True):
+        assert s.plan_end == tuple(h.plan[-1, :2]) and s.ocp_goal == tuple(h.ocp_goal), f"period {s.t}"
 
 
 def test_m4f_float_controller_stays_within_the_float_tolerance_period_by_period(ctl_m4f: dict[str, CtlResult]) -> None:
