@@ -79,8 +79,9 @@ bench: venv
 	$(GEN) bench --out out/bench
 	$(GEN) bench --compare --compare-out out/compare
 
-# The default spec's solver as firmware: double on a Cortex-M7, float on a Cortex-M4F, each replaying
-# a recorded crowd under QEMU and compared with the host library.
+# The default spec's solver and navigation controller as firmware: double on a Cortex-M7, float on a
+# Cortex-M4F, each replaying a recorded crowd (the solver) and a recorded closed loop (the controller)
+# under QEMU and compared with the host library (docs/firmware.md).
 firmware: venv
 	$(call apt_install,$(APT_FIRMWARE))
 	$(GEN) generate -o generated/paper --force

@@ -11,7 +11,8 @@ from typing import Any
 
 from ..codegen.cli import non_negative_int
 from ..codegen.spec import SpecError, load_spec
-from ..status import STOP_REASONS
+from ..status import OUTCOME_NAMES, STOP_REASONS
+from .controller import DEADLINE_PROBE_MS, ControllerAgreement, ControllerRun, run_controller_firmware
 from .image import CPUS, FirmwareError, image_size, load_replay_file, run_firmware
 from .report import footprint_report, report_markdown
 
@@ -39,7 +40,44 @@ def _cmd_firmware(args: argparse.Namespace) -> int:
     print(f"against the host library: max |u0 diff| {agree.max_u0_diff:.3g}, max relative cost diff "
           f"{agree.max_cost_rel_diff:.3g}, same status/stop decisions: {agree.same_decisions}"
           + (f" ({agree.first_mismatch})" if agree.first_mismatch else ""))
+    if args.controller_steps == 0:
+        return 0
+    try:
+        crun, cagree, celf, _ = run_controller_firmware(args.dir, args.cpu, steps=args.controller_steps,
+                                                        seed=args.seed, cold=args.cold, timeout=args.timeout)
+    except FirmwareError as err:
+        print(f"humanmpc-gen: {err}", file=sys.stderr)
+        return 1
+    _print_controller(crun, cagree, celf, args.cpu)
     return 0
+
+
+def _print_controller(run: ControllerRun, agree: ControllerAgreement, elf: Path, cpu: str) -> None:
+    print()
+    print(f"# the controller of {run.name} ({run.real}) on {cpu}: <name>_controller_step on recorded inputs; "
+          f"sizeof({run.name}_controller) = {run.controller_bytes} B")
+    print(f"{'period':>6} {'outcome':>12} {'stop':>16} {'people':>12} {'v':>9} {'omega':>9} {'a':>9} "
+          f"{'instructions':>13}")
+    for s in run.steps:
+        stop = (STOP_REASONS.get(s.stop_reason, str(s.stop_reason)) or "-") if s.stop else "-"
+        outcome = OUTCOME_NAMES.get(s.outcome, str(s.outcome)) + ("+rec" if s.recovered else "")
+        people = ",".join(str(i) for i in s.people_index) or "-"
+        print(f"{s.t:>6} {outcome:>12} {stop:>16} {people:>12} {s.command[0]:>9.5f} {s.command[1]:>9.5f} "
+              f"{s.u[0]:>9.5f} {s.instructions:>13,}")
+    ins = run.instructions
+    size = image_size(elf)
+    print(f"instructions per controller period (QEMU icount, not cycles): mean {ins.mean():,.0f}, min {ins.min():,}, "
+          f"max {ins.max():,}")
+    print(f"controller image: flash {size.flash:,} B (text {size.text:,} + data {size.data:,}; includes the replay), "
+          f"RAM {size.ram:,} B, stack high-water mark {run.stack_bytes:,} B")
+    print(f"clock hook: the controller's own time of the periods / SysTick's: "
+          f"{sum(s.time_total_ms for s in run.steps) * 1e6 / max(1, int(ins.sum())):.5f}; a deadline of "
+          f"{DEADLINE_PROBE_MS:g} ms stopped the robot with reason "
+          f"{STOP_REASONS.get(run.probe_stop_reason, str(run.probe_stop_reason))} after {run.probe_time_ms:.4f} ms")
+    print(f"controller against the host library: max |command diff| {agree.max_command_diff:.3g}, max |u diff| "
+          f"{agree.max_u_diff:.3g}, max relative to the bounds {agree.max_rel:.3g} (median {agree.median_rel:.3g}), "
+          f"periods with other decisions: {agree.outcome_mismatches} of {agree.steps}, other people: "
+          f"{agree.people_mismatches}" + (f" ({agree.first_mismatch})" if agree.first_mismatch else ""))
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
@@ -77,7 +115,10 @@ def add_firmware_parser(subparsers: Any) -> None:
         "embedded as constants, a footprint program, Makefile), cross-compile it with arm-none-eabi-gcc for "
         "--cpu, run it under qemu-system-arm with semihosting and instruction counting, and compare its results "
         "with the host library on the same inputs. Without --replay the inputs are recorded from a closed loop "
-        "of the host solver in a random crowd.")
+        "of the host solver in a random crowd. Then the same for the navigation controller "
+        "(<name>_controller_step): a closed loop of the host controller (a path past a wall of obstacle points, "
+        "walking people with tracker ids and covariances) recorded and replayed period by period, with a "
+        "clock installed by <name>_controller_set_clock.")
     p.add_argument("dir", type=Path, help="generated solver folder")
     p.add_argument("--cpu", choices=sorted(CPUS), default="cortex-m7",
                    help="cortex-m4 (mps2-an386, single-precision FPU) or cortex-m7 (mps2-an500); default cortex-m7")
@@ -87,7 +128,11 @@ def add_firmware_parser(subparsers: Any) -> None:
     p.add_argument("--seed", type=non_negative_int, default=0, help="seed of the recorded crowd (default 0)")
     p.add_argument("--humans", type=int, help="humans in the recorded crowd (default: the solver's N_h)")
     p.add_argument("--cold", action="store_true",
-                   help="reset the solver before every step (each step then depends on its own inputs only)")
+                   help="reset the solver (and the controller) before every step (each step then depends on its own "
+                   "inputs only)")
+    p.add_argument("--controller-steps", type=non_negative_int, default=140,
+                   help="control periods of the recorded controller loop replayed after the solver's (default 140, "
+                   "0: none)")
     p.add_argument("--timeout", type=float, default=600.0, help="QEMU time limit in seconds (default 600)")
     p.set_defaults(func=_cmd_firmware)
 
