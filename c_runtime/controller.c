@@ -41,22 +41,11 @@
 #define CONTROLLER_NUDGE_OMEGA HM_R(0.5)
 #define CONTROLLER_NUDGE_SECONDS HM_R(1.0)
 
-static int controller_finite(hm_real v)
-{
-    return (v - v) == (v - v);
-}
-
-static int controller_point_ok(const hm_real *p)
-{
-    return controller_finite(p[0]) && controller_finite(p[1]) && hm_fabs(p[0]) <= HM_MONITOR_MAX_POSITION &&
-           hm_fabs(p[1]) <= HM_MONITOR_MAX_POSITION;
-}
-
 /* 1 when every input is usable: counts within their capacities, numbers finite and not absurd. */
 static int controller_input_ok(const hm_controller_input *cin)
 {
     int i;
-    if (!controller_finite(cin->time) || !controller_point_ok(cin->pose)) return 0;
+    if (!monitor_finite(cin->time) || !monitor_position_ok(cin->pose)) return 0;
     if (!(hm_fabs(cin->pose[2]) <= HM_MONITOR_MAX_ANGLE) || !(hm_fabs(cin->v) <= HM_MONITOR_MAX_SPEED) ||
         !(hm_fabs(cin->omega) <= HM_MONITOR_MAX_SPEED))
         return 0;
@@ -64,14 +53,14 @@ static int controller_input_ok(const hm_controller_input *cin)
         cin->n_tracks > HM_MAX_TRACKS || cin->n_obstacles < 0 || cin->n_obstacles > HM_MAX_OBSTACLE_POINTS ||
         (cin->has_goal != 0 && cin->has_goal != 1))
         return 0;
-    if (cin->has_goal && (!controller_point_ok(cin->goal) || !(hm_fabs(cin->goal[2]) <= HM_MONITOR_MAX_ANGLE)))
+    if (cin->has_goal && (!monitor_position_ok(cin->goal) || !(hm_fabs(cin->goal[2]) <= HM_MONITOR_MAX_ANGLE)))
         return 0;
     for (i = 0; i < cin->n_path; i++)
-        if (!controller_point_ok(cin->path[i])) return 0;
+        if (!monitor_position_ok(cin->path[i])) return 0;
     for (i = 0; i < cin->n_tracks; i++) {
         const hm_real *t = cin->tracks[i];
         const hm_real *c = cin->track_covariances[i];
-        if (!controller_point_ok(t) || !(hm_fabs(t[2]) <= HM_MONITOR_MAX_SPEED) ||
+        if (!monitor_position_ok(t) || !(hm_fabs(t[2]) <= HM_MONITOR_MAX_SPEED) ||
             !(hm_fabs(t[3]) <= HM_MONITOR_MAX_SPEED))
             return 0;
         if (cin->track_has_covariance[i] != 0 && cin->track_has_covariance[i] != 1) return 0;
@@ -81,7 +70,7 @@ static int controller_input_ok(const hm_controller_input *cin)
             return 0;
     }
     for (i = 0; i < cin->n_obstacles; i++)
-        if (!controller_point_ok(cin->obstacles[i])) return 0;
+        if (!monitor_position_ok(cin->obstacles[i])) return 0;
     return 1;
 }
 
@@ -290,6 +279,7 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
     const unsigned long long t0 = ocp_nlp_now(s);
     const hm_real horizon = HM_R(HM_DT) * (hm_real)HM_N;
     hm_controller_goal g;
+    hm_real path[HM_N + 1][2];
     unsigned long long t1;
     int slow = 0;
     controller_clear_output(out);
@@ -346,8 +336,9 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
         out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
         return out->outcome;
     }
-    controller_select_people(s, cin, in, out);
-    controller_nearest_obstacle(s, cin, c->solver.params.v_bounds[1], in);
+    controller_expected_path(s, cin, path);
+    controller_select_people(path, cin, in, out);
+    controller_nearest_obstacle(path, cin, c->solver.params.v_bounds[1], in);
     t1 = ocp_nlp_now(s);
     ocp_nlp_sqp_rti_step(s, in, &c->out);
     out->time_solver_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t1);

@@ -10,17 +10,19 @@
  */
 #include "controller_people.h"
 
-/* The robot's expected position at node n. */
-static void controller_expected(const hm_solver *s, const hm_controller_input *cin, int n, hm_real *p)
+HM_FUNC void controller_expected_path(const hm_solver *s, const hm_controller_input *cin, hm_real path[HM_N + 1][2])
 {
-    if (s->warm) {
-        const int k = n + 1 <= HM_N ? n + 1 : HM_N;
-        p[0] = s->x[k][0];
-        p[1] = s->x[k][1];
-    } else {
-        const hm_real d = cin->v * HM_R(HM_DT) * (hm_real)n;
-        p[0] = cin->pose[0] + d * hm_cos(cin->pose[2]);
-        p[1] = cin->pose[1] + d * hm_sin(cin->pose[2]);
+    int n;
+    for (n = 0; n <= HM_N; n++) {
+        if (s->warm) {
+            const int k = n + 1 <= HM_N ? n + 1 : HM_N;
+            path[n][0] = s->x[k][0];
+            path[n][1] = s->x[k][1];
+        } else {
+            const hm_real d = cin->v * HM_R(HM_DT) * (hm_real)n;
+            path[n][0] = cin->pose[0] + d * hm_cos(cin->pose[2]);
+            path[n][1] = cin->pose[1] + d * hm_sin(cin->pose[2]);
+        }
     }
 }
 
@@ -32,14 +34,12 @@ static hm_real controller_sigma(const hm_real *c)
     return hm_sqrt(hm_fmax(mean + hm_sqrt(half * half + c[1] * c[1]), HM_R(0.0)));
 }
 
-HM_FUNC void controller_select_people(const hm_solver *s, const hm_controller_input *cin, hm_input *in,
+HM_FUNC void controller_select_people(hm_real path[HM_N + 1][2], const hm_controller_input *cin, hm_input *in,
                                       hm_controller_output *out)
 {
     hm_real score[HM_MAX_TRACKS];
-    hm_real path[HM_N + 1][2];
     int chosen[HM_MAX_TRACKS];
     int i, n, j, k = 0;
-    for (n = 0; n <= HM_N; n++) controller_expected(s, cin, n, path[n]);
     for (i = 0; i < cin->n_tracks; i++) {
         const hm_real *t = cin->tracks[i];
         hm_real best = HM_INF;
@@ -77,21 +77,23 @@ HM_FUNC void controller_select_people(const hm_solver *s, const hm_controller_in
     }
 }
 
-HM_FUNC void controller_nearest_obstacle(const hm_solver *s, const hm_controller_input *cin, hm_real speed,
+HM_FUNC void controller_nearest_obstacle(hm_real path[HM_N + 1][2], const hm_controller_input *cin, hm_real speed,
                                          hm_input *in)
 {
-    hm_real path[HM_N + 2][2];
     hm_real best = HM_INF;
     int i, n, pick = -1;
-    path[0][0] = cin->pose[0];
-    path[0][1] = cin->pose[1];
-    for (n = 0; n <= HM_N; n++) controller_expected(s, cin, n, path[n + 1]);
     for (i = 0; i < cin->n_obstacles; i++) {
-        for (n = 0; n <= HM_N + 1; n++) {
-            const hm_real dx = cin->obstacles[i][0] - path[n][0];
-            const hm_real dy = cin->obstacles[i][1] - path[n][1];
-            /* how soon the robot could be at the point: reaching node n, then going straight to it */
-            const hm_real soon = hm_sqrt(dx * dx + dy * dy) + speed * HM_R(HM_DT) * (hm_real)(n > 0 ? n - 1 : 0);
+        const hm_real *o = cin->obstacles[i];
+        /* how soon the robot could be at the point: from where it is, or reaching node n, then going
+         * straight to it */
+        hm_real soon = hm_sqrt((o[0] - cin->pose[0]) * (o[0] - cin->pose[0]) +
+                               (o[1] - cin->pose[1]) * (o[1] - cin->pose[1]));
+        for (n = -1; n <= HM_N; n++) {
+            if (n >= 0) {
+                const hm_real dx = o[0] - path[n][0];
+                const hm_real dy = o[1] - path[n][1];
+                soon = hm_sqrt(dx * dx + dy * dy) + speed * HM_R(HM_DT) * (hm_real)n;
+            }
             if (soon < best) {
                 best = soon;
                 pick = i;

@@ -5,14 +5,14 @@
  */
 #include "monitor.h"
 
-static int monitor_finite(hm_real v)
+HM_FUNC int monitor_finite(hm_real v)
 {
     /* v - v is 0 for finite v and NaN for NaN or infinity; no isfinite(), which C99 freestanding
      * targets may lack for float. */
     return (v - v) == (v - v);
 }
 
-static int monitor_position_ok(const hm_real *p)
+HM_FUNC int monitor_position_ok(const hm_real *p)
 {
     return monitor_finite(p[0]) && monitor_finite(p[1]) && hm_fabs(p[0]) <= HM_MONITOR_MAX_POSITION &&
            hm_fabs(p[1]) <= HM_MONITOR_MAX_POSITION;

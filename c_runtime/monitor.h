@@ -35,6 +35,10 @@ enum hm_stop_reason { HM_STOP_REASON_TABLE(HM_STATUS_ENUM_ROW) };
 #define HM_MONITOR_MAX_ANGLE HM_R(1.0e4)      /* rad: headings may wind, but not without bound */
 #define HM_MONITOR_MAX_SPEED HM_R(100.0)      /* m/s */
 
+/* 1 when v is finite; 1 when the point p[0], p[1] is finite and within HM_MONITOR_MAX_POSITION (the
+ * controller checks its path, tracks and obstacle points with the same tests). */
+HM_FUNC int monitor_finite(hm_real v);
+HM_FUNC int monitor_position_ok(const hm_real *p);
 HM_FUNC int monitor_check_input(const hm_input *in, int check_x0);
 HM_FUNC int monitor_check_params(const hm_params *p);
 HM_FUNC hm_real monitor_distance_now(const hm_input *in);
