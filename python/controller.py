@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .codegen.params import Param
-from .results import ControllerResult, record_dtype
+from .results import ControllerResult, c_array_view, record_dtype
 from .runtime_params import RuntimeParams
 
 
@@ -64,18 +64,15 @@ class Controller:
         self.max_path_points = len(c.path)
         self.max_obstacle_points = len(c.obstacles)
 
-        def view(cdata: Any, shape: tuple[int, ...], dtype: Any) -> np.ndarray:
-            return np.frombuffer(ffi.buffer(cdata), dtype=dtype).reshape(shape)
-
         rt = self.dtype
-        self._pose = view(c.pose, (3,), rt)
-        self._goal = view(c.goal, (3,), rt)
-        self._path = view(c.path, (self.max_path_points, 2), rt)
-        self._tracks = view(c.tracks, (self.max_tracks, 4), rt)
-        self._ids = view(c.track_ids, (self.max_tracks,), np.int32)
-        self._has_cov = view(c.track_has_covariance, (self.max_tracks,), np.int32)
-        self._cov = view(c.track_covariances, (self.max_tracks, 3), rt)
-        self._obstacles = view(c.obstacles, (self.max_obstacle_points, 2), rt)
+        self._pose = c_array_view(ffi, c.pose, (3,), rt)
+        self._goal = c_array_view(ffi, c.goal, (3,), rt)
+        self._path = c_array_view(ffi, c.path, (self.max_path_points, 2), rt)
+        self._tracks = c_array_view(ffi, c.tracks, (self.max_tracks, 4), rt)
+        self._ids = c_array_view(ffi, c.track_ids, (self.max_tracks,), np.int32)
+        self._has_cov = c_array_view(ffi, c.track_has_covariance, (self.max_tracks,), np.int32)
+        self._cov = c_array_view(ffi, c.track_covariances, (self.max_tracks, 3), rt)
+        self._obstacles = c_array_view(ffi, c.obstacles, (self.max_obstacle_points, 2), rt)
 
     # -- parameters ---------------------------------------------------------------------------
     @property

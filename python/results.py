@@ -37,6 +37,12 @@ def record_dtype(ffi: Any, ctype: str) -> np.dtype:
                      "offsets": [ft.offset for _, ft in fields], "itemsize": ffi.sizeof(ctype)})
 
 
+def c_array_view(ffi: Any, cdata: Any, shape: tuple[int, ...], dtype: Any = np.float64) -> Any:
+    """A numpy array over a C array (of the solver's real type: float32 for a float solver), written
+    in place: how the solver and the controller fill their input structs."""
+    return np.frombuffer(ffi.buffer(cdata), dtype=dtype).reshape(shape)
+
+
 class StepResult:
     """What one solver step returns: a copy of the C output struct, taken in one memcpy, whose fields
     are read on access (so a step costs no per-field conversion). Arrays are float64 and stay valid

@@ -19,14 +19,9 @@ from numpy.typing import ArrayLike
 
 from .codegen.params import Param
 from .controller import Controller
-from .results import StepResult, record_dtype
+from .results import StepResult, c_array_view, record_dtype
 from .runtime_params import RuntimeParams
 from .steplog import StepLog
-
-
-def _view(ffi: Any, cdata: Any, shape: tuple[int, ...], dtype: Any = np.float64) -> Any:
-    """A numpy array over a C array of the solver's real type (float32 for a float solver)."""
-    return np.frombuffer(ffi.buffer(cdata), dtype=dtype).reshape(shape)
 
 
 class Solver:
@@ -60,14 +55,14 @@ class Solver:
         # are handed out as float64 copies either way.
         self.dtype = np.dtype(np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64)
         rt = self.dtype
-        self._x0 = _view(ffi, self._in.x0, (4,), rt)
-        self._goal = _view(ffi, self._in.goal, (4,), rt)
-        self._obstacle = _view(ffi, self._in.obstacle, (2,), rt)
+        self._x0 = c_array_view(ffi, self._in.x0, (4,), rt)
+        self._goal = c_array_view(ffi, self._in.goal, (4,), rt)
+        self._obstacle = c_array_view(ffi, self._in.obstacle, (2,), rt)
         self._nh, self._nodes = dims.nh, N + 1
         self._counts = (0, False)   # what _in.n_humans, _in.has_obstacle hold (ffi.new zeroes them)
         # the first k humans' rows, for every k, as views made once
-        h_now = _view(ffi, self._in.humans_now, (nh_alloc, 2), rt)
-        h_pred = _view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2), rt)
+        h_now = c_array_view(ffi, self._in.humans_now, (nh_alloc, 2), rt)
+        h_pred = c_array_view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2), rt)
         self._h_now_first = [h_now[:k] for k in range(nh_alloc + 1)]
         self._h_pred_first = [h_pred[:, :k] for k in range(nh_alloc + 1)]
         self._out_buffer = ffi.buffer(self._out)

@@ -6,12 +6,14 @@ import shutil
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import humanmpc
 from humanmpc.codegen.build import build
 from humanmpc.codegen.generate import generate
 from humanmpc.codegen.spec import Spec, resolve_spec
+from humanmpc.planners.interface import Observation, PlanResult
 
 QUIET: Callable[[str], None] = lambda _msg: None  # noqa: E731
 REPO_ROOT = Path(__file__).resolve().parent.parent
@@ -54,3 +56,19 @@ def require_tool(name: str) -> str:
     if path is None:
         pytest.fail(f"{name} is not installed: `make test` installs it (see APT_PACKAGES in the Makefile)")
     return path
+
+
+class Recorder:
+    """A planner that drives straight at 0.5 m/s and keeps what it was shown."""
+
+    name = "recorder"
+
+    def __init__(self) -> None:
+        self.seen: list[Observation] = []
+
+    def reset(self) -> None:
+        self.seen.clear()
+
+    def plan(self, obs: Observation) -> PlanResult:
+        self.seen.append(obs)
+        return PlanResult(u=np.array([(0.5 - obs.x[3]) / obs.dt, 0.0]))

@@ -15,25 +15,9 @@ from humanmpc.eval.evaluate import evaluate
 from humanmpc.eval.metrics import compute_metrics
 from humanmpc.eval.plots import animate_episode, plot_episodes
 from humanmpc.planners.dwb import DWBPlanner
-from humanmpc.planners.interface import Observation, PlanResult
 from humanmpc.planners.registry import make_planner, planner_names, register_planner
 from humanmpc.sim.scenarios import make_scenario
-
-
-class Recorder:
-    """A planner that drives straight at 0.5 m/s and keeps what it was shown."""
-
-    name = "recorder"
-
-    def __init__(self) -> None:
-        self.seen: list[Observation] = []
-
-    def reset(self) -> None:
-        self.seen.clear()
-
-    def plan(self, obs: Observation) -> PlanResult:
-        self.seen.append(obs)
-        return PlanResult(u=np.array([(0.5 - obs.x[3]) / obs.dt, 0.0]))
+from tests.conftest import Recorder
 
 
 def test_episode_feeds_observations_and_predictions_and_logs_consistently() -> None:

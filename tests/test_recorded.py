@@ -13,7 +13,6 @@ from humanmpc.eval.commands import add_demo_parser, add_evaluate_parser, add_sim
 from humanmpc.eval.episode import run_episode
 from humanmpc.eval.evaluate import safety_table
 from humanmpc.eval.metrics import compute_metrics, human_distances
-from humanmpc.planners.interface import Observation, PlanResult
 from humanmpc.sim.crowd import Crowd, CrowdSpec, HumanCrowd
 from humanmpc.sim.predict import ConstantVelocityPredictor
 from humanmpc.sim.recorded import (
@@ -33,6 +32,7 @@ from humanmpc.sim.scenarios import (
     plan_crossings,
 )
 from humanmpc.sim.world import World
+from tests.conftest import Recorder
 
 # 25 frames per second, an annotation every 10 frames (0.4 s). Pedestrian 1 walks along x at 1 m/s and is
 # not seen at frame 130 (a gap: two tracks); pedestrian 2 stands at (5, 5) from frame 110 to 130; pedestrian 3
@@ -156,22 +156,6 @@ def test_the_simulated_crowd_names_everyone_always() -> None:
 # Closed loop among people who come and go.
 
 
-class Straight:
-    """Drives at 0.5 m/s along its heading and keeps what it was shown."""
-
-    name = "straight"
-
-    def __init__(self) -> None:
-        self.seen: list[Observation] = []
-
-    def reset(self) -> None:
-        self.seen.clear()
-
-    def plan(self, obs: Observation) -> PlanResult:
-        self.seen.append(obs)
-        return PlanResult(u=np.array([(0.5 - obs.x[3]) / obs.dt, 0.0]))
-
-
 def _hand_scenario(t0: float = 0.0) -> Scenario:
     rec = parse_recording(TRACKS, "hand")
     x0 = np.array([0.0, -3.0, 0.0, 0.5])
@@ -180,7 +164,7 @@ def _hand_scenario(t0: float = 0.0) -> Scenario:
 
 
 def test_an_episode_among_recorded_people_logs_who_is_present_and_shows_only_them() -> None:
-    planner = Straight()
+    planner = Recorder()
     log = run_episode(_hand_scenario(), planner)
     assert log.steps == 25 and log.humans.shape == (26, 4, 2)
     np.testing.assert_array_equal(log.human_ids, [0, 1, 2, 3])
@@ -256,7 +240,7 @@ def test_a_recorded_scene_has_no_seed_beyond_its_crossings() -> None:
 def test_an_episode_in_a_recorded_scene_replays_the_recording() -> None:
     scenario = make_scenario("crowds_zara01", 5)
     assert isinstance(scenario.crowd, RecordedCrowdSpec)
-    planner = Straight()
+    planner = Recorder()
     log = run_episode(scenario, planner)
     rec, t0 = scenario.crowd.recording, scenario.crowd.t0
     for t in (0, 37, log.steps):

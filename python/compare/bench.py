@@ -72,7 +72,7 @@ class BenchResult:
     min_human_distance: float
 
 
-def _unicycle(x: np.ndarray, u: np.ndarray, dt: float, substeps: int = 10) -> np.ndarray:
+def unicycle_step(x: np.ndarray, u: np.ndarray, dt: float, substeps: int = 10) -> np.ndarray:
     h = dt / substeps
     for _ in range(substeps):
         x = x + h * np.array([x[3] * np.cos(x[2]), x[3] * np.sin(x[2]), u[1], u[0]])
@@ -147,7 +147,7 @@ def run_closed_loop(solver: Solver, k: int, seed: int, steps: int,
         out["dist"].append(float(np.min(np.linalg.norm(scene.pos - x[:2], axis=1))) if k else np.inf)
         out["reason"].append(r.stop_reason)
         u = r.u0 if np.all(np.isfinite(r.u0)) else np.array([-1.0, 0.0])
-        x = _unicycle(x, u, dims.dt)
+        x = unicycle_step(x, u, dims.dt)
         x[3] = min(max(x[3], 0.0), 1.0)
         scene.advance(dims.dt)
     return out

@@ -33,9 +33,9 @@ from .bench import (
     OBSTACLE_RADIUS,
     CrowdScene,
     TimingStats,
-    _unicycle,
     machine_description,
     pin_to_one_core,
+    unicycle_step,
 )
 
 OBSTACLE_POINTS = 64  # points on the obstacle's boundary, 3 cm apart
@@ -86,7 +86,7 @@ def run_controller_loop(ctl: Controller, tracks: int, seed: int, steps: int) -> 
         out["outcome"].append(r.outcome)
         out["dist"].append(float(np.min(np.linalg.norm(scene.pos - x[:2], axis=1))) if tracks else np.inf)
         omega = float(r.command[1])
-        x = _unicycle(x, r.u, dt)
+        x = unicycle_step(x, r.u, dt)
         x[3] = min(max(x[3], 0.0), 1.0)
         scene.advance(dt)
     return out

@@ -21,7 +21,6 @@ thousand instructions, which must end in the deadline's protective stop: the hoo
 from __future__ import annotations
 
 import math
-import struct
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -41,6 +40,8 @@ from .image import (
     INSN_PER_TICK,
     FirmwareError,
     build_firmware,
+    check_calibration,
+    hex_real,
     package_spec,
     print_progress,
     require_tools,
@@ -437,10 +438,6 @@ class ControllerRun:
         return np.array([s.instructions for s in self.steps], dtype=np.int64)
 
 
-def _real(text: str, real: str) -> float:
-    return float(struct.unpack(">f" if real == "float" else ">d", bytes.fromhex(text))[0])
-
-
 def parse_controller_output(text: str) -> ControllerRun:
     """Parse the controller replay's console output; FirmwareError when incomplete or inconsistent."""
     lines = text.splitlines()
@@ -453,10 +450,7 @@ def parse_controller_output(text: str) -> ControllerRun:
                             "line):\n" + text[-2000:])
     _, name, cpu, real, n_steps, nbytes = begin[0]
     run = ControllerRun(name, cpu, real, int(nbytes), int(calib[0][1]), int(calib[0][2]))
-    ratio = run.calib_instructions / max(run.calib_ticks, 1)
-    if abs(ratio - INSN_PER_TICK) > 0.5:
-        raise FirmwareError(f"SysTick calibration: {ratio:.3f} instructions per tick, expected {INSN_PER_TICK} "
-                            "(is QEMU running with -icount shift=0?)")
+    check_calibration(run.calib_instructions, run.calib_ticks)
     for ln in lines:
         if not ln.startswith("cstep "):
             continue
@@ -464,7 +458,7 @@ def parse_controller_output(text: str) -> ControllerRun:
         ints = [int(v) for v in f[1:14]]
         n_people = ints[12]
         people = tuple(int(v) for v in f[14:14 + n_people])
-        reals = [_real(v, real) for v in f[14 + n_people:26 + n_people]]
+        reals = [hex_real(v, real) for v in f[14 + n_people:26 + n_people]]
         i = ints
         run.steps.append(ControllerLine(
             i[0], i[1], i[2], i[3], i[4], i[5], i[6], i[7], i[8], i[9], i[10], i[11], people,
@@ -473,7 +467,7 @@ def parse_controller_output(text: str) -> ControllerRun:
     if len(run.steps) != int(n_steps):
         raise FirmwareError(f"the controller firmware reported {len(run.steps)} periods of {n_steps}")
     run.probe_stop_reason = int(probe[0][1])
-    run.probe_time_ms = _real(probe[0][2], real)
+    run.probe_time_ms = hex_real(probe[0][2], real)
     run.stack_bytes = int(stack[0][1])
     return run
 

@@ -345,9 +345,18 @@ class FirmwareRun:
         return np.array([s.u0 for s in self.steps])
 
 
-def _real(text: str, real: str) -> float:
+def hex_real(text: str, real: str) -> float:
+    """A real printed by the firmware as the hex of its big-endian bytes (exact, no decimal rounding)."""
     raw = bytes.fromhex(text)
     return float(struct.unpack(">f" if real == "float" else ">d", raw)[0])
+
+
+def check_calibration(instructions: int, ticks: int) -> None:
+    """FirmwareError unless the firmware's SysTick counted INSN_PER_TICK instructions per tick."""
+    ratio = instructions / max(ticks, 1)
+    if abs(ratio - INSN_PER_TICK) > 0.5:
+        raise FirmwareError(f"SysTick calibration: {ratio:.3f} instructions per tick, expected {INSN_PER_TICK} "
+                            "(is QEMU running with -icount shift=0?)")
 
 
 def parse_replay_output(text: str) -> FirmwareRun:
@@ -359,16 +368,13 @@ def parse_replay_output(text: str) -> FirmwareRun:
         raise FirmwareError("the firmware output is incomplete (no begin/calib/end line):\n" + text[-2000:])
     _, name, cpu, real, n_steps, solver_bytes = begin[0]
     run = FirmwareRun(name, cpu, real, int(solver_bytes), int(calib[0][1]), int(calib[0][2]))
-    ratio = run.calib_instructions / max(run.calib_ticks, 1)
-    if abs(ratio - INSN_PER_TICK) > 0.5:
-        raise FirmwareError(f"SysTick calibration: {ratio:.3f} instructions per tick, expected {INSN_PER_TICK} "
-                            "(is QEMU running with -icount shift=0?)")
+    check_calibration(run.calib_instructions, run.calib_ticks)
     for ln in lines:
         if not ln.startswith("step "):
             continue
         f = ln.split()
         ints = [int(v) for v in f[1:8]]
-        reals = [_real(v, real) for v in f[8:16]]
+        reals = [hex_real(v, real) for v in f[8:16]]
         run.steps.append(StepLine(ints[0], ints[1], ints[2], ints[3], ints[4], ints[5], ints[6],
                                   (reals[0], reals[1]), (reals[2], reals[3]), reals[4], reals[5],
                                   (reals[6], reals[7]), int(f[16])))
