@@ -353,6 +353,9 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
         c->time_recovery = cin->time;
         out->recovered = controller_recover(c, t0, 1, out);
     }
+    /* the OCP sees N_h people; the command must keep its distance from every track */
+    if (!c->out.stop && !controller_check_separation(cin, in->x0, c->out.command[0], &c->params))
+        ocp_nlp_protective_stop(s, in, &c->out, HM_STOP_SEPARATION);
     controller_report(c, out);
     if (out->stalled && !out->stop) out->outcome = HM_OUTCOME_STALLED;
     out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);

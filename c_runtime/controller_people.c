@@ -10,6 +10,8 @@
  */
 #include "controller_people.h"
 
+#include "monitor.h"
+
 HM_FUNC void controller_expected_path(const hm_solver *s, const hm_controller_input *cin, hm_real path[HM_N + 1][2])
 {
     int n;
@@ -105,4 +107,20 @@ HM_FUNC void controller_nearest_obstacle(hm_real path[HM_N + 1][2], const hm_con
         in->obstacle[0] = cin->obstacles[pick][0];
         in->obstacle[1] = cin->obstacles[pick][1];
     }
+}
+
+HM_FUNC int controller_check_separation(const hm_controller_input *cin, const hm_real *x0, hm_real v,
+                                        const hm_params *params)
+{
+    const hm_real cos_t = hm_cos(x0[2]), sin_t = hm_sin(x0[2]);
+    const hm_real tol = HM_R(1e-6) + params->qp_tol; /* as the solver's own check */
+    int i;
+    if (!params->separation || !(v > tol)) return 1;
+    for (i = 0; i < cin->n_tracks; i++) {
+        const hm_real *t = cin->tracks[i];
+        if (v > monitor_separation_speed(x0, cos_t, sin_t, t, t + 2, params->d_h, params->reaction_time,
+                                         -params->a_bounds[0], v) + tol)
+            return 0;
+    }
+    return 1;
 }

@@ -27,4 +27,9 @@ HM_FUNC void controller_select_people(hm_real path[HM_N + 1][2], const hm_contro
 HM_FUNC void controller_nearest_obstacle(hm_real path[HM_N + 1][2], const hm_controller_input *cin, hm_real speed,
                                          hm_input *in);
 
+/* 1 when the command speed v from the state x0 keeps speed and separation (monitor_separation_speed)
+ * from every track, not only the N_h the OCP sees; always 1 without params->separation. */
+HM_FUNC int controller_check_separation(const hm_controller_input *cin, const hm_real *x0, hm_real v,
+                                        const hm_params *params);
+
 #endif /* CONTROLLER_PEOPLE_H */

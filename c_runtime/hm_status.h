@@ -37,7 +37,8 @@
     X(STOP_QP_FAILED, 4, qp_failed, "protective stop (C1): the QP was not solved") \
     X(STOP_NONFINITE, 5, nonfinite, "protective stop (C1): non-finite number in the solution") \
     X(STOP_HUMAN_TOO_CLOSE, 6, human_too_close, "protective stop (C2): a human is within d_h of the robot") \
-    X(STOP_UNSAFE_PLAN, 7, unsafe_plan, "protective stop (C2): the planned path comes within d_h of a human")
+    X(STOP_UNSAFE_PLAN, 7, unsafe_plan, "protective stop (C2): the planned path comes within d_h of a human") \
+    X(STOP_SEPARATION, 8, separation, "protective stop (speed and separation): at the commanded speed, braking after the reaction time would not stop the robot before a person closing in comes within d_h")
 
 /* What a controller step ended with (controller.c): what the robot is doing, in one word. */
 #define HM_OUTCOME_TABLE(X) \

@@ -74,6 +74,50 @@ HM_FUNC hm_real monitor_distance_now(const hm_input *in)
     return best;
 }
 
+HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_real sin_t, const hm_real *h,
+                                         const hm_real *vh, hm_real d_h, hm_real t_r, hm_real a_brake,
+                                         hm_real v_cap)
+{
+    const hm_real dx = h[0] - p[0], dy = h[1] - p[1];
+    const hm_real d2 = dx * dx + dy * dy;
+    const hm_real ahead = cos_t * dx + sin_t * dy; /* d cos_phi */
+    hm_real speed_h, reach, d, cos_phi, c, alpha, beta, gamma;
+    if (!(ahead > HM_R(0.0))) return HM_INF;
+    /* Most people are far: no square root when even v_cap, with the person's whole speed towards the
+     * robot, keeps the separation. */
+    speed_h = hm_sqrt(vh[0] * vh[0] + vh[1] * vh[1]);
+    reach = d_h + v_cap * t_r + v_cap * v_cap / (HM_R(2.0) * a_brake) + speed_h * (t_r + v_cap / a_brake);
+    if (d2 >= reach * reach) return HM_INF;
+    d = hm_sqrt(d2);
+    cos_phi = ahead / d;
+    c = -(vh[0] * dx + vh[1] * dy) / d;
+    if (c < HM_R(0.0)) c = HM_R(0.0);
+    /* alpha v^2 + beta v + gamma <= 0, gamma < 0 for a bound above 0: its positive root, written
+     * without the cancellation of -beta + sqrt(...) */
+    alpha = cos_phi / (HM_R(2.0) * a_brake);
+    beta = cos_phi * t_r + c / a_brake;
+    gamma = c * t_r - (d - d_h);
+    if (!(gamma < HM_R(0.0))) return HM_R(0.0);
+    return HM_R(-2.0) * gamma / (beta + hm_sqrt(beta * beta - HM_R(4.0) * alpha * gamma));
+}
+
+HM_FUNC int monitor_check_separation(const hm_input *in, const hm_params *p, hm_real v)
+{
+    const hm_real cos_t = hm_cos(in->x0[2]), sin_t = hm_sin(in->x0[2]);
+    /* the QP keeps the same bound to its tolerance; beyond that, braking could not keep it */
+    const hm_real tol = HM_R(1e-6) + p->qp_tol;
+    int j;
+    if (!p->separation || !(v > tol)) return 1;
+    for (j = 0; j < ocp_nlp_clamp_humans(in); j++) {
+        const hm_real vh[2] = {(in->humans_pred[1][j][0] - in->humans_pred[0][j][0]) / HM_R(HM_DT),
+                               (in->humans_pred[1][j][1] - in->humans_pred[0][j][1]) / HM_R(HM_DT)};
+        if (v > monitor_separation_speed(in->x0, cos_t, sin_t, in->humans_now[j], vh, p->d_h, p->reaction_time,
+                                         -p->a_bounds[0], v) + tol)
+            return 0;
+    }
+    return 1;
+}
+
 HM_FUNC const char *monitor_stop_reason_message(int reason)
 {
     switch (reason) {

@@ -10,6 +10,12 @@
  *   C2      the solution is not safe: the robot already is within d_h of a present human, or the
  *           planned path comes within d_h of a present human's current position (its nodes 1..N,
  *           and the state reached by applying u0 from the measured state, by the model).
+ *   separation  (params.separation) the commanded speed is above the speed from which braking after
+ *           the reaction time stops the robot before a present human closing in at their predicted
+ *           velocity comes within d_h (monitor_separation_speed). The OCP bounds its speeds the same
+ *           way, so this fires when braking at the acceleration bound cannot keep the bound (a person
+ *           appearing close, running at the robot) or for tracks the OCP does not see (the controller
+ *           checks all of them).
  *
  * A protective stop brakes to standstill within the acceleration bound, without turning. After any
  * stop the solver starts the next step cold, so it recovers by itself once the situation clears and
@@ -42,6 +48,22 @@ HM_FUNC int monitor_position_ok(const hm_real *p);
 HM_FUNC int monitor_check_input(const hm_input *in, int check_x0);
 HM_FUNC int monitor_check_params(const hm_params *p);
 HM_FUNC hm_real monitor_distance_now(const hm_input *in);
+
+/* Speed and separation (ISO/TS 15066's protective separation, applied to people): the largest speed
+ * v >= 0 along the heading (cos_t, sin_t) from p such that a robot that keeps v for t_r, then brakes
+ * at a_brake > 0, stops before it comes within d_h of a person at h whose velocity vh closes in on
+ * p. With d the distance, cos_phi the heading's cosine towards the person and c >= 0 the person's
+ * closing speed, v keeps
+ *     cos_phi (v t_r + v^2 / (2 a_brake)) + c (t_r + v / a_brake) <= d - d_h.
+ * HM_INF when no speed up to v_cap needs bounding (a person who is not ahead, cos_phi <= 0, or far
+ * enough); 0 when even a standstill does not keep d_h (c t_r >= d - d_h). */
+HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_real sin_t, const hm_real *h,
+                                         const hm_real *vh, hm_real d_h, hm_real t_r, hm_real a_brake,
+                                         hm_real v_cap);
+
+/* 1 when the command v keeps speed and separation (above) from every present human of in, whose
+ * velocities are those of their predictions over the first interval; x0's heading is the robot's. */
+HM_FUNC int monitor_check_separation(const hm_input *in, const hm_params *p, hm_real v);
 HM_FUNC const char *monitor_stop_reason_message(int reason);
 
 #endif /* HM_MONITOR_H */

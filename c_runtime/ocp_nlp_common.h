@@ -10,6 +10,8 @@
  *   s.t. x_0 = measured state, x_{n+1} = F(x_n, u_n), bounds on v (n >= 1), a and omega,
  *        d(p_n, h_{i,0}) + s_{i,n} >= d_h   (humans' current positions; exact penalty on s)
  *        d(p_n, o) + s_n >= d_s             (closest obstacle; L1 + L2 penalty on s)
+ *        v_n <= speed-and-separation bound  (params.separation: from node n - 1's geometry, frozen at
+ *                                            the linearisation point; monitor_separation_speed)
  * for n = 1..N. The human rows are exact-penalty soft rows: with a penalty above every multiplier
  * the optimum of the hard problem is kept whenever it exists, and the QP stays feasible when it
  * does not (a human already too close, a linearisation that cannot reach the half-plane). The

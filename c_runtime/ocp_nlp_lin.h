@@ -24,4 +24,8 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact);
 /* The measured state into the QP, as the offset of its fixed x_0 from the iterate's. */
 HM_FUNC void ocp_nlp_set_x0(hm_solver *s, const hm_input *in);
 
+/* The exact penalty (human_slack_l1) on the iterate's speeds above the speed-and-separation bounds
+ * of the last ocp_nlp_set_x0; 0 without params.separation. */
+HM_FUNC hm_real ocp_nlp_separation_penalty(const hm_solver *s);
+
 #endif /* OCP_NLP_LIN_H */

@@ -122,7 +122,8 @@ HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output
     out->command[0] = x0_ok ? out->x[1][3] : HM_R(0.0);
     out->command[1] = HM_R(0.0);
     s->prepared = 0;
-    if (reason != HM_STOP_UNSAFE_PLAN && reason != HM_STOP_HUMAN_TOO_CLOSE) s->warm = 0;
+    if (reason != HM_STOP_UNSAFE_PLAN && reason != HM_STOP_HUMAN_TOO_CLOSE && reason != HM_STOP_SEPARATION)
+        s->warm = 0;
 }
 
 HM_FUNC void ocp_nlp_clear_output(hm_output *out)
@@ -177,5 +178,6 @@ HM_FUNC int ocp_nlp_check_plan(const hm_solver *s, const hm_input *in)
         if (!ocp_nlp_keeps_distance(s->x[n], in, limit)) return HM_STOP_UNSAFE_PLAN;
     hm_model_dynamics(in->x0, s->u[0], x1, A, B);
     if (!ocp_nlp_keeps_distance(x1, in, limit)) return HM_STOP_UNSAFE_PLAN;
+    if (!monitor_check_separation(in, &s->params, s->x[1][3])) return HM_STOP_SEPARATION;
     return HM_STOP_NONE;
 }

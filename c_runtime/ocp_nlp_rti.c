@@ -140,7 +140,7 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
         s->prepared = 0;
         t_feedback = ocp_nlp_now(s);
     }
-    if (reason == HM_STOP_NONE || reason == HM_STOP_UNSAFE_PLAN) s->warm = 1;
+    if (reason == HM_STOP_NONE || reason == HM_STOP_UNSAFE_PLAN || reason == HM_STOP_SEPARATION) s->warm = 1;
     /* after a stop the next QP starts cold: after the braking retry (HM_STOP_UNSAFE_PLAN) its kept
      * iterate is the retry's, whose linearisation the plan has left; a stop before solving leaves one
      * from an older step */

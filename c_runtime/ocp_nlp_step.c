@@ -63,7 +63,8 @@ HM_FUNC int ocp_nlp_qp_step(hm_solver *s, int shifted, int *qp_iter)
 }
 
 /* l1 merit of the iterate: objective with the soft-row penalties + mu * (|dynamics gaps|_1 +
- * |x_0 - measured x0|_1). Bounds are linear, so every step of the line search keeps them. */
+ * |x_0 - measured x0|_1). Bounds are linear, so every step of the line search keeps those its base
+ * kept; the speed-and-separation bounds, which move with the iterate, count with their excess. */
 static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
 {
     const hm_params *p = &s->params;
@@ -99,7 +100,7 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
                                            human ? p->human_slack_l2 : p->slack_l2);
         }
     }
-    return merit + mu * gaps;
+    return merit + ocp_nlp_separation_penalty(s) + mu * gaps;
 }
 
 /* Full SQP step with a backtracking line search on the l1 merit (Armijo on the decrease that the

@@ -23,6 +23,9 @@ typedef struct HM_NS(solver) {
      * screen_radius[n] are left out of the QP (screened, their lg kept in screened_lg and made
      * absent in qp.lg) and checked after. */
     HM_REAL screen_radius[HM_N + 1];
+    /* Speed and separation (params.separation): the bound on v at node n from the geometry of node
+     * n - 1 (ocp_nlp_lin.c); node 1's from the measured state, at feedback. */
+    HM_REAL v_separation[HM_N + 1];
     int qp_solves;   /* QPs solved in the current step */
     HM_REAL screened_lg[HM_N + 1][HM_NG];
     unsigned char screened[HM_N + 1][HM_NG];

@@ -200,6 +200,17 @@ PARAMS: tuple[Param, ...] = (
           "exact-penalty weight on the human rows: must exceed their multipliers", valid=_WEIGHT),
     Param("human_slack_l2", "humans.slack_l2", "real", 100.0, "L2 penalty on the human-row slack (0.5*l2*s^2)",
           valid=_WEIGHT),
+    # Speed and separation (issue 23; ISO/TS 15066's protective separation, for people): the paper keeps
+    # the plan d_h from where people are now; a person walking towards the robot covers a metre while it
+    # brakes from 0.8 m/s. Not in the Ipopt reference: the bound is frozen at each linearisation point.
+    Param("separation", "humans.separation", "flag", True,
+          "speed and separation: at every node the speed towards each person is at most the speed from which "
+          "braking after reaction_time at the lower acceleration bound stops the robot before it comes within "
+          "d_h of them, while they close in at their velocity; the monitor checks the command the same way",
+          paper=False),
+    Param("reaction_time", "humans.reaction_time", "real", 0.3,
+          "time before braking starts (the command's period, the base's latency) in the speed-and-separation "
+          "bound", unit="s", valid=Range(0.0, 10.0)),
     Param("d_s", "obstacle.d_s", "real", 0.5, "soft minimum distance to the closest obstacle", unit="m",
           valid=_DIST, problem=True),
     Param("slack_l1", "obstacle.slack_l1", "real", 1000.0, "L1 penalty on the obstacle slack", valid=_WEIGHT,

@@ -203,6 +203,8 @@ class Humans:
     d_h: float = param("humans.d_h")
     slack_l1: float = param("humans.slack_l1")
     slack_l2: float = param("humans.slack_l2")
+    separation: bool = param("humans.separation")
+    reaction_time: float = param("humans.reaction_time")
 
 
 @dataclass(frozen=True)
