@@ -336,6 +336,9 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
         out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
         return out->outcome;
     }
+    /* A speed to track that the robot may not use towards its goal rewards the plan for spending it
+     * elsewhere: with people between it and the goal, it circled at cruising speed. */
+    in->goal[3] = hm_fmin(in->goal[3], controller_separation_towards(cin, in->x0, in->goal, in->goal[3], &c->params));
     controller_expected_path(s, cin, path);
     controller_select_people(path, cin, in, out);
     controller_nearest_obstacle(path, cin, c->solver.params.v_bounds[1], in);

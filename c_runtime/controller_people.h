@@ -32,4 +32,10 @@ HM_FUNC void controller_nearest_obstacle(hm_real path[HM_N + 1][2], const hm_con
 HM_FUNC int controller_check_separation(const hm_controller_input *cin, const hm_real *x0, hm_real v,
                                         const hm_params *params);
 
+/* The speed-and-separation bound of every track for a robot at x0 heading straight for the point
+ * `to` (HM_INF when none binds below v_cap, or without params->separation): the speed the OCP can use
+ * towards its goal. */
+HM_FUNC hm_real controller_separation_towards(const hm_controller_input *cin, const hm_real *x0, const hm_real *to,
+                                              hm_real v_cap, const hm_params *params);
+
 #endif /* CONTROLLER_PEOPLE_H */

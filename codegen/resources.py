@@ -5,6 +5,8 @@ both work."""
 
 from __future__ import annotations
 
+import functools
+import hashlib
 from importlib import resources
 from pathlib import Path
 
@@ -47,3 +49,20 @@ def check_resources() -> None:
 def runtime_files() -> list[Path]:
     """The hand-written C runtime copied into every generated solver."""
     return sorted(p for p in runtime_dir().iterdir() if p.suffix in (".c", ".h"))
+
+
+@functools.lru_cache(maxsize=1)
+def generator_digest() -> str:
+    """SHA-256 of everything that turns a spec into C besides the spec: the generator's modules, the
+    templates and the C runtime (relative paths and contents). Two generators with the same digest
+    write the same package for the same spec; caches of built solvers are keyed by it with the spec's
+    digest, so a changed runtime is never served from a cache built by an older one."""
+    h = hashlib.sha256()
+    roots = (("codegen", Path(__file__).resolve().parent, "*.py"), ("templates", templates_dir(), "*.j2"),
+             ("runtime", runtime_dir(), "*.[ch]"))
+    for label, root, pattern in roots:
+        for path in sorted(root.rglob(pattern)):
+            h.update(f"{label}/{path.relative_to(root).as_posix()}\0".encode())
+            h.update(path.read_bytes())
+            h.update(b"\0")
+    return h.hexdigest()

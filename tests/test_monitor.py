@@ -93,6 +93,23 @@ def test_human_walking_into_the_robot_ends_in_a_stop_and_the_robot_resumes_after
     assert x[0] > 1.0  # and went on towards the goal
 
 
+def test_person_running_at_the_robot_stops_it_for_separation_and_it_resumes_after(default_dir: Path) -> None:
+    solver = humanmpc.load(default_dir)  # speed and separation on (the default spec)
+    inp = clean_inputs()
+    assert not solver.step(**inp).stop
+    run = dict(inp, humans_now=inp["humans_now"].copy(), humans_pred=inp["humans_pred"].copy())
+    # 1.5 m ahead, running at the robot at 3 m/s: the person alone covers 0.9 m of the 1.0 m gap while the
+    # robot reacts (0.3 s); no speed above 0.03 m/s keeps the separation, and braking reaches 0.5 m/s
+    run["humans_now"][0] = inp["x0"][:2] + 1.5 * np.array([np.cos(0.1), np.sin(0.1)])
+    run["humans_pred"][:, 0] = run["humans_now"][0] - 3.0 * np.array([np.cos(0.1), np.sin(0.1)]) * DT * \
+        np.arange(N + 1)[:, None]
+    r = solver.step(**run)
+    assert r.reason == "separation" and r.stop_reason == 8
+    assert_braking(r, solver, v0=inp["x0"][3])
+    r = solver.step(**inp)
+    assert not r.stop and r.status_name == "solved"
+
+
 def test_one_microsecond_deadline_stops_inside_the_qp_and_clears(fresh: humanmpc.Solver) -> None:
     inp = clean_inputs()
     fresh.set_params(deadline_ms=0.001)

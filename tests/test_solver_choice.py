@@ -185,7 +185,7 @@ def test_make_planner_loads_the_selected_solver_and_by_default_the_default_spec_
 
     choice = solver_dir.selected_solver()
     assert choice.spec is None and choice.solver_dir is None
-    expected = Path("generated", ".cache", f"paper-{Spec().digest()[:12]}")
+    expected = Path("generated", ".cache", f"paper-{solver_dir.cache_key(Spec())}")
     assert expected == DEFAULT_SOLVER_DIR == solver_dir.DEFAULT_SOLVER_DIR and reexported is ensure_solver
     select_solver(solver_dir=user_dir)
     held = humanmpc.load(user_dir).spec_hash

@@ -25,6 +25,7 @@ after the choice and inherit it. Without a choice it is the built-in default spe
 from __future__ import annotations
 
 import fcntl
+import hashlib
 import json
 import os
 import shutil
@@ -36,6 +37,7 @@ from pathlib import Path
 
 from ..codegen.build import build, is_stale
 from ..codegen.generate import MANIFEST, generate
+from ..codegen.resources import generator_digest
 from ..codegen.spec import Spec
 
 CACHE_DIR = Path("generated") / ".cache"  # in the working folder, as `humanmpc-gen generate` writes generated/<name>
@@ -48,9 +50,15 @@ class SolverDirError(ValueError):
     """A solver folder that cannot be used as asked; the message names the folder and what to do."""
 
 
+def cache_key(spec: Spec) -> str:
+    """12 hex digits of the SHA-256 of the spec's digest and the generator's (its modules, templates and C
+    runtime): another humanmpc, or an edited checkout, gets its own folder instead of a stale build."""
+    return hashlib.sha256(f"{spec.digest()}:{generator_digest()}".encode()).hexdigest()[:12]
+
+
 def cache_dir(spec: Spec, root: Path = CACHE_DIR) -> Path:
-    """The cache folder of ``spec``'s solver: ``root/<name>-<digest[:12]>``."""
-    return root / f"{spec.name}-{spec.digest()[:12]}"
+    """The cache folder of ``spec``'s solver: ``root/<name>-<cache_key(spec)>``."""
+    return root / f"{spec.name}-{cache_key(spec)}"
 
 
 DEFAULT_SOLVER_DIR = cache_dir(Spec())  # the built-in default spec's solver, as ensure_solver() keeps it
