@@ -73,14 +73,17 @@ def fw_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="session")
 def double_dir(fw_root: Path) -> Path:
-    """The paper's spec, double precision."""
-    return make_solver(fw_root, {"name": "fwd"})
+    """The default spec, double precision, without speed and separation: with it the robot slows before
+    anyone comes within d_h and no replay of the first twelve seeds has a C2 stop; seed 6's separation
+    stops come with a float QP failure on the host where the Cortex-M4F stops for separation (float
+    decisions near a failing QP: issue 20). The controller's replay below runs with it."""
+    return make_solver(fw_root, {"name": "fwd", "humans": {"separation": False}})
 
 
 @pytest.fixture(scope="session")
 def float_dir(fw_root: Path) -> Path:
-    """The paper's spec in single precision."""
-    return make_solver(fw_root, {"name": "fwf", "precision": "float"})
+    """double_dir's spec in single precision."""
+    return make_solver(fw_root, {"name": "fwf", "precision": "float", "humans": {"separation": False}})
 
 
 @pytest.fixture(scope="session")
@@ -241,8 +244,9 @@ CTL_SEED = 0
 # Sizes for a Cortex-M4F: N_h = 5 of up to 8 tracks, a path of up to 32 points, 32 obstacle points,
 # the default horizon (N = 50): the float controller is 196 KB of RAM (docs/firmware.md).
 # The replay's scene was recorded and its tolerances measured with no weight on omega (the default
-# before weights.control = [0, 2]); with the weight the scene ends before the goal and the stops.
-CTL_SPEC = {"humans": {"max": 5}, "weights": {"control": [0.0, 0.0]},
+# before weights.control = [0, 2]) and without speed and separation (the default since issue 23): with
+# the weight the scene ends before the goal and the stops, with the separation it has no C2 stop.
+CTL_SPEC = {"humans": {"max": 5, "separation": False}, "weights": {"control": [0.0, 0.0]},
             "controller": {"max_tracks": 8, "max_path_points": 32, "max_obstacle_points": 32}}
 # Cortex-M7 double against the x86-64 host, per period of the replay. The arithmetic is the same
 # (IEEE, no contraction on either side); the math libraries are not: newlib's sin/cos/exp differ from
