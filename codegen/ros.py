@@ -67,12 +67,21 @@ def ros_package_name(solver_name: str) -> str:
     return package
 
 
+def yaml_float(x: float) -> str:
+    """A float as YAML 1.1 (rosparam's PyYAML) reads it back as a float: 1e-06 would be a string."""
+    text = c_float(x)
+    mantissa, e, exponent = text.partition("e")
+    if e and "." not in mantissa:
+        text = f"{mantissa}.0e{exponent}"
+    return text
+
+
 def _yaml_value(value: Any, ctype: str) -> str:
     if ctype == "int":
         return str(int(value))
     if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(c_float(float(x)) for x in value) + "]"
-    return c_float(float(value))
+        return "[" + ", ".join(yaml_float(float(x)) for x in value) + "]"
+    return yaml_float(float(value))
 
 
 def ros_context(spec: Spec) -> dict[str, Any]:
