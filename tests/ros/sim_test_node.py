@@ -8,8 +8,10 @@ It publishes odometry and tf (odom -> base_link, static map -> odom and base_lin
 people as humanmpc_msgs/TrackedPersons and the goal in the map frame, so the node's tf2 conversions
 are on the path to the goal. A script drives the scene:
 
-1. drive to goal A; on the way a person steps beside the robot, within d_h, and leaves again;
-2. goal A reached; goal B given; while driving, the odometry stops for 2 s, then the people for 2 s;
+1. drive to goal A (a geometry_msgs/PoseStamped on goal); on the way a person steps beside the
+   robot, within d_h, and leaves again;
+2. goal A reached; goal B given as a global plan (nav_msgs/Path of 300 poses on plan); while driving,
+   the odometry stops for 2 s, then the people for 2 s;
 3. goal B reached.
 
 Checked: both goals reached; the protective stop topic reports the person within one control period
@@ -42,7 +44,7 @@ import tf2_ros
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import PoseStamped, TransformStamped, Twist
 from humanmpc_msgs.msg import ProtectiveStop, TrackedPerson, TrackedPersons
-from nav_msgs.msg import Odometry
+from nav_msgs.msg import Odometry, Path
 from sensor_msgs.msg import LaserScan
 
 from humanmpc.sim.crowd import Crowd, CrowdSpec
@@ -110,6 +112,7 @@ class ClosedLoop(unittest.TestCase):
         self.people_pub = rospy.Publisher("people", TrackedPersons, queue_size=5)
         self.scan_pub = rospy.Publisher("scan", LaserScan, queue_size=5)
         self.goal_pub = rospy.Publisher("goal", PoseStamped, queue_size=1, latch=True)
+        self.plan_pub = rospy.Publisher("plan", Path, queue_size=1, latch=True)
         self.tf_pub = tf2_ros.TransformBroadcaster()
         self.static_tf = tf2_ros.StaticTransformBroadcaster()
         rospy.Subscriber("cmd_vel", Twist, self.on_cmd, tcp_nodelay=True)
@@ -220,6 +223,20 @@ class ClosedLoop(unittest.TestCase):
         g.pose.orientation.w = 1.0
         self.goal_pub.publish(g)
 
+    def publish_plan(self, goal: tuple[float, float], n: int) -> None:
+        """A straight global plan of n poses from the robot to goal, in the map frame (n above the
+        controller's max_path_points: the node subsamples it)."""
+        path = Path()
+        path.header.stamp = rospy.Time.now()
+        path.header.frame_id = "map"
+        for p in map_from_odom(np.linspace(self.x[:2], np.array(goal), n)):
+            ps = PoseStamped()
+            ps.header = path.header
+            ps.pose.position.x, ps.pose.position.y = float(p[0]), float(p[1])
+            ps.pose.orientation.w = 1.0
+            path.poses.append(ps)
+        self.plan_pub.publish(path)
+
     # --- the scene -----------------------------------------------------------------------------------
     def test_closed_loop(self) -> None:
         self.static_tf.sendTransform([self.transform(rospy.Time.now(), "map", "odom", *MAP_TO_ODOM),
@@ -275,7 +292,7 @@ class ClosedLoop(unittest.TestCase):
                     events["intruder_left"] = t
                 if np.linalg.norm(pos - GOAL_A) < self.goal_tolerance + 0.1 and abs(speed) < 0.05:
                     events["goal_a"] = t
-                    self.publish_goal(GOAL_B)
+                    self.publish_plan(GOAL_B, 300)
                     phase = "to_b"
             elif phase == "to_b":
                 if first_at_speed_b is None and speed > 0.4:
