@@ -18,10 +18,15 @@ STAMP_TEST := $(VENV)/.installed-test
 APT_RUN := gcc make binutils python3-venv python3-dev
 # The Cortex-M cross compiler, newlib and QEMU (docs/firmware.md).
 APT_FIRMWARE := gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
+# Debian's ROS 1 for the generated ROS node (docs/ros.md): catkin, roscpp and the message packages
+# (ros-core-dev), tf2 for C++ and Python, rostest, rosbag and rospy for the simulation node.
+APT_ROS := ros-core-dev libtf2-ros-dev libtf2-geometry-msgs-dev python3-tf2-ros python3-rospy \
+	python3-rostest python3-rosbag python3-nav-msgs python3-sensor-msgs python3-geometry-msgs \
+	python3-visualization-msgs python3-diagnostic-msgs
 # The suite on top: clang (+ its sanitizer/fuzzer runtime), CMake for the generated package, valgrind,
 # Debian's Ipopt (with the BLAS/LAPACK it links) for the C reference solver, g++ and Eigen for the C++
 # face, and the firmware toolchain for the firmware tests.
-APT_TEST := $(APT_RUN) $(APT_FIRMWARE) clang libclang-rt-14-dev cmake valgrind \
+APT_TEST := $(APT_RUN) $(APT_FIRMWARE) $(APT_ROS) clang libclang-rt-14-dev cmake valgrind \
 	coinor-libipopt-dev libblas-dev liblapack-dev libeigen3-dev g++
 
 .PHONY: help test demo bench firmware venv venv-test lint clean

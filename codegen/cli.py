@@ -1,4 +1,4 @@
-"""The generator's commands (check, generate, build, info, keys), mounted by humanmpc-gen (humanmpc.cli)."""
+"""The generator's commands (check, generate, ros, build, info, keys), mounted by humanmpc-gen (humanmpc.cli)."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from pathlib import Path
 from . import __version__
 from .build import BuildError, build, read_manifest
 from .generate import GenerateError, generate
+from .ros import write_ros
 from .spec import SpecError, describe_schema, load_spec
 
 
@@ -25,6 +26,11 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     spec = load_spec(args.spec)
     out = generate(spec, args.output or Path("generated") / spec.name, force=args.force)
     print(out)
+    return 0
+
+
+def _cmd_ros(args: argparse.Namespace) -> int:
+    print(write_ros(args.dir, args.output, force=args.force))
     return 0
 
 
@@ -95,7 +101,7 @@ def _cmd_keys(args: argparse.Namespace) -> int:
 
 
 def add_generator_commands(sub: argparse._SubParsersAction) -> None:
-    """The generator's subcommands: check, generate, build, info, keys."""
+    """The generator's subcommands: check, generate, ros, build, info, keys."""
     p = sub.add_parser("check", help="validate a spec and print it resolved (defaults filled in)",
                        description="Validate SPEC (or the built-in default spec) and print the resolved spec.")
     p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
@@ -108,6 +114,16 @@ def add_generator_commands(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", type=Path, help="output folder (default: generated/<name>)")
     p.add_argument("--force", action="store_true", help="replace an existing generated folder")
     p.set_defaults(func=_cmd_generate)
+
+    p = sub.add_parser("ros", help="write the ROS 1 node (catkin packages) of a generated solver",
+                       description="Write the catkin packages of the ROS 1 node over the controller of DIR (a "
+                       "generated solver): humanmpc_msgs and <name>_ros, into a folder for a workspace's src/ "
+                       "(docs/ros.md). Written atomically.")
+    p.add_argument("dir", type=Path, help="generated solver folder (humanmpc-gen generate's)")
+    p.add_argument("-o", "--output", type=Path,
+                   help="output folder (default: <name>_ros_src beside DIR)")
+    p.add_argument("--force", action="store_true", help="replace an existing folder written by humanmpc-gen ros")
+    p.set_defaults(func=_cmd_ros)
 
     p = sub.add_parser("build", help="compile a generated package into its libraries",
                        description="Compile DIR (a generated package) with its Makefile into "

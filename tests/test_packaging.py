@@ -117,10 +117,12 @@ def test_the_wheel_installed_in_a_fresh_venv_generates_builds_loads_and_steps_a_
     work.mkdir()
     gen = env_dir / "bin" / "humanmpc-gen"
     (work / "tiny.yaml").write_text("name: tiny\nhorizon: {N: 10, T: 1.0}\nhumans: {max: 2}\n")
-    for cmd in (["generate", "tiny.yaml", "-o", "out/tiny"], ["build", "out/tiny"]):
+    for cmd in (["generate", "tiny.yaml", "-o", "out/tiny"], ["build", "out/tiny"], ["ros", "out/tiny"]):
         proc = subprocess.run([str(gen), *cmd], cwd=work, env=_clean_env(), capture_output=True, text=True,
                               timeout=600, check=False)
         assert proc.returncode == 0, proc.stderr[-3000:]
+    # the ROS node's templates are package data too (templates/ros/)
+    assert (work / "out" / "tiny_ros_src" / "tiny_ros" / "src" / "tiny_node.cpp").is_file()
     # every module of the checkout is in the wheel and imports (acados_peer runs only in acados' venv)
     walk = ("import importlib, pkgutil, humanmpc\n"
             "names = sorted(m.name for m in pkgutil.walk_packages(humanmpc.__path__, 'humanmpc.'))\n"

@@ -1,0 +1,202 @@
+"""The ROS 1 face of a generated solver: a catkin package set beside it (docs/ros.md).
+
+``write_ros(SOLVER_DIR, OUT)`` writes into OUT, a folder to put into a catkin workspace's src/:
+
+    OUT/humanmpc_ros.json        what humanmpc wrote (solver name, spec hash): --force replaces only such a folder
+    OUT/humanmpc_msgs/           the messages: TrackedPerson(s) in, ProtectiveStop out
+    OUT/<name>_ros/              the node: src/<name>_node.cpp over the C controller, launch/, config/,
+                                 solver/ (a copy of the generated C package, compiled by the node's CMakeLists)
+
+The node only converts messages into ``<name>_controller_input`` and the output into messages; the
+navigation is the C controller's. Everything printed into C++ comes from the solver's validated spec,
+the parameter table and the status table, through ``c_identifier`` / ``c_float`` / ``_c_string``.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from . import __version__
+from .build import BuildError, read_manifest
+from .generate import GenerateError, write_atomically
+from .params import PARAMS, spec_params
+from .render import _c_string, c_float, c_identifier, make_environment
+from .spec import Spec, SpecError, load_spec
+from .status import status_tables
+
+ROS_MARKER = "humanmpc_ros.json"
+MSGS_PACKAGE = "humanmpc_msgs"
+# REP 144: a package name is lower case letters, digits and underscores, starting with a letter.
+_ROS_PACKAGE = re.compile(r"[a-z][a-z0-9_]*")
+# The solver's files the package copies: everything but the build folders.
+_BUILD_DIRS = ("build", "build-cmake")
+
+
+@dataclass(frozen=True)
+class NodeStopReason:
+    """A stop reason of the node's own, above the controller's (docs/ros.md)."""
+
+    id: str
+    value: int
+    name: str
+    message: str
+
+
+# The node's own stop reasons: what the controller cannot see. The order is the node's priority.
+NODE_STOP_REASONS = (
+    NodeStopReason("STOP_STALE_ODOMETRY", 100, "stale_odometry",
+                   "protective stop (node): no odometry within odom_timeout"),
+    NodeStopReason("STOP_STALE_PEOPLE", 101, "stale_people",
+                   "protective stop (node): no tracked people within people_timeout"),
+    NodeStopReason("STOP_NO_TRANSFORM", 102, "no_transform",
+                   "protective stop (node): no tf2 transform of the path, goal, people or scan into the "
+                   "odometry frame"),
+)
+
+
+def ros_package_name(solver_name: str) -> str:
+    """The node's catkin package: <name>_ros in lower case (REP 144)."""
+    package = f"{c_identifier(solver_name).lower()}_ros"
+    if not _ROS_PACKAGE.fullmatch(package):
+        raise GenerateError(f"{package!r} is not a ROS package name (REP 144: [a-z][a-z0-9_]*)")
+    return package
+
+
+def yaml_float(x: float) -> str:
+    """A float as YAML 1.1 (rosparam's PyYAML) reads it back as a float: 1e-06 would be a string."""
+    text = c_float(x)
+    mantissa, e, exponent = text.partition("e")
+    if e and "." not in mantissa:
+        text = f"{mantissa}.0e{exponent}"
+    return text
+
+
+def _yaml_value(value: Any, ctype: str) -> str:
+    if ctype == "int":
+        return str(int(value))
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(yaml_float(float(x)) for x in value) + "]"
+    return yaml_float(float(value))
+
+
+def ros_context(spec: Spec) -> dict[str, Any]:
+    """What the ROS templates print, each item checked as it enters C++ or YAML."""
+    name = c_identifier(spec.name)
+    values = spec_params(spec)
+    tables = status_tables()
+    codes = {r.value for r in tables["stop_reason"]}
+    for r in NODE_STOP_REASONS:
+        if r.value in codes:
+            raise GenerateError(f"the node's stop reason {r.name} = {r.value} is a value of the controller's "
+                                "stop reasons (runtime/hm_status.h): renumber it in humanmpc.codegen.ros")
+    params = [
+        {
+            "c_name": c_identifier(p.name),
+            "c_type": "int" if p.ctype == "int" else f"{name}_real",
+            "size": p.size,
+            "yaml": _yaml_value(values[p.name], p.ctype),
+            "doc": _c_string(f"{p.described}; must be {p.rule}"),
+        }
+        for p in PARAMS
+    ]
+
+    def rows(key: str) -> list[dict[str, Any]]:
+        return [{"value": int(r.value), "name": c_identifier(r.name), "message": _c_string(r.message)}
+                for r in tables[key]]
+
+    return {
+        "name": name,
+        "NAME": name.upper(),
+        "package": ros_package_name(name),
+        "version": __version__,
+        "spec_hash": spec.digest(),
+        "N": int(spec.horizon.N),
+        "NT": int(spec.controller.max_tracks),
+        "NP": int(spec.controller.max_path_points),
+        "NK": int(spec.controller.max_obstacle_points),
+        "dt": c_float(spec.dt),
+        "params": params,
+        "stop_reasons": rows("stop_reason"),
+        "outcomes": rows("outcome"),
+        "node_reasons": [{"id": c_identifier(r.id), "value": int(r.value), "name": c_identifier(r.name),
+                          "message": _c_string(r.message)} for r in NODE_STOP_REASONS],
+    }
+
+
+# template (templates/ros/) -> path in OUT ({package}, {name} filled in)
+ROS_TEMPLATES = {
+    "msgs_package.xml.j2": f"{MSGS_PACKAGE}/package.xml",
+    "msgs_CMakeLists.txt.j2": f"{MSGS_PACKAGE}/CMakeLists.txt",
+    "TrackedPerson.msg.j2": f"{MSGS_PACKAGE}/msg/TrackedPerson.msg",
+    "TrackedPersons.msg.j2": f"{MSGS_PACKAGE}/msg/TrackedPersons.msg",
+    "ProtectiveStop.msg.j2": f"{MSGS_PACKAGE}/msg/ProtectiveStop.msg",
+    "package.xml.j2": "{package}/package.xml",
+    "CMakeLists.txt.j2": "{package}/CMakeLists.txt",
+    "node.cpp.j2": "{package}/src/{name}_node.cpp",
+    "node.launch.j2": "{package}/launch/{name}.launch",
+    "params.yaml.j2": "{package}/config/{name}.yaml",
+}
+
+
+def render_ros(context: dict[str, Any]) -> dict[str, str]:
+    """Relative path -> rendered text, for every ROS template."""
+    env = make_environment()
+    return {out.format(package=context["package"], name=context["name"]):
+            env.get_template(f"ros/{tpl}").render(**context) for tpl, out in ROS_TEMPLATES.items()}
+
+
+def solver_spec(solver_dir: Path) -> Spec:
+    """The spec of a generated solver folder: its spec.yaml, checked against its manifest's hash."""
+    try:
+        manifest = read_manifest(solver_dir)
+    except BuildError as err:
+        raise GenerateError(str(err)) from None
+    spec_file = solver_dir / "spec.yaml"
+    if not spec_file.is_file():
+        raise GenerateError(f"{spec_file} is missing: regenerate the solver with humanmpc-gen generate")
+    try:
+        spec = load_spec(spec_file)
+    except SpecError as err:
+        raise GenerateError(f"{spec_file}: {err}") from None
+    if manifest.get("spec_hash") != spec.digest():
+        raise GenerateError(f"{spec_file} does not hold the spec of {solver_dir / 'manifest.json'} (spec_hash "
+                            f"{manifest.get('spec_hash')}, spec.yaml's {spec.digest()}): regenerate the solver")
+    return spec
+
+
+def _populate(solver_dir: Path, spec: Spec, out: Path) -> None:
+    context = ros_context(spec)
+    for rel, text in render_ros(context).items():
+        path = out / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    shutil.copytree(solver_dir, out / context["package"] / "solver",
+                    ignore=lambda d, names: [n for n in names if Path(d) == solver_dir and n in _BUILD_DIRS])
+    (out / ROS_MARKER).write_text(json.dumps({
+        "generator": "humanmpc",
+        "generator_version": __version__,
+        "solver": spec.name,
+        "spec_hash": spec.digest(),
+        "packages": [MSGS_PACKAGE, context["package"]],
+    }, indent=2) + "\n")
+
+
+def default_ros_dir(solver_dir: Path, spec: Spec) -> Path:
+    """Beside the solver: <solver_dir's parent>/<name>_ros_src."""
+    return solver_dir.resolve().parent / f"{ros_package_name(spec.name)}_src"
+
+
+def write_ros(solver_dir: str | Path, out_dir: str | Path | None = None, *, force: bool = False) -> Path:
+    """Write the ROS package set of the generated solver in ``solver_dir``; return its folder."""
+    d = Path(solver_dir).resolve()
+    spec = solver_spec(d)
+    dest = Path(out_dir) if out_dir is not None else default_ros_dir(d, spec)
+    if dest.resolve() == d or d in dest.resolve().parents:
+        raise GenerateError(f"{dest}: the ROS packages go beside the solver folder {d}, not inside it")
+    write_atomically(dest, lambda tmp: _populate(d, spec, tmp), force, marker=ROS_MARKER)
+    return dest.resolve()
