@@ -31,7 +31,7 @@
 #define NH_ALLOC ((int)(sizeof(((S(input) *)0)->humans_now) / sizeof(((S(input) *)0)->humans_now[0])))
 #define NNODES ((int)(sizeof(((S(output) *)0)->x) / sizeof(((S(output) *)0)->x[0])))
 #define DT 0.1
-#define N_REASONS 8
+#define N_REASONS 11
 
 #ifdef OCP_QP_IPM_PROFILE
 #include <time.h>
