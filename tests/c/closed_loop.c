@@ -31,7 +31,7 @@
 #define NH_ALLOC ((int)(sizeof(((S(input) *)0)->humans_now) / sizeof(((S(input) *)0)->humans_now[0])))
 #define NNODES ((int)(sizeof(((S(output) *)0)->x) / sizeof(((S(output) *)0)->x[0])))
 #define DT 0.1
-#define N_REASONS 11
+#define MAX_REASONS 32 /* the table has n_reasons rows (counted at start, by their messages) */
 
 #ifdef OCP_QP_IPM_PROFILE
 #include <time.h>
@@ -93,7 +93,8 @@ int main(int argc, char **argv)
 {
     const long steps = argc > 1 ? atol(argv[1]) : 1000;
     const double deadline_ms = argc > 3 ? atof(argv[3]) : 20.0;
-    long t, counts[N_REASONS] = {0}, violations = 0, injected = 0;
+    long t, counts[MAX_REASONS] = {0}, violations = 0, injected = 0;
+    int n_reasons = 0;
     double x[4] = {0.0, 0.0, 0.0, 0.0}, goal[2][2] = {{12.0, 0.0}, {0.0, 0.0}}, worst_ms = 0.0;
     double closest = 1e9;
     const int fixed = argc > 4 && strcmp(argv[4], "fixed") == 0;
@@ -103,6 +104,7 @@ int main(int argc, char **argv)
     double total_ms = 0.0, prepare_ms = 0.0;
     rng_state = (unsigned long long)(argc > 2 ? atol(argv[2]) : 1) * 2654435761ULL + 1ULL;
     if (NH_ALLOC > 64) return 100;
+    while (n_reasons < MAX_REASONS && strcmp(S(stop_reason_message)(n_reasons), "unknown stop reason") != 0) n_reasons++;
     S(solver_init)(&solver);
     S(solver_params)(&solver)->deadline_ms = deadline_ms;
     for (j = 0; j < NH_ALLOC; j++) spawn(j, x);
@@ -158,7 +160,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "step %ld: non-finite command\n", t);
             violations++;
         }
-        if ((out.stop != 0) != (out.stop_reason != 0) || out.stop_reason < 0 || out.stop_reason >= N_REASONS) {
+        if ((out.stop != 0) != (out.stop_reason != 0) || out.stop_reason < 0 || out.stop_reason >= n_reasons) {
             fprintf(stderr, "step %ld: stop %d with reason %d\n", t, out.stop, out.stop_reason);
             violations++;
         }
@@ -174,7 +176,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "step %ld: no stop but QP status %d\n", t, out.qp_status);
             violations++;
         }
-        if (out.stop_reason >= 0 && out.stop_reason < N_REASONS) counts[out.stop_reason]++;
+        if (out.stop_reason >= 0 && out.stop_reason < n_reasons) counts[out.stop_reason]++;
         qp_iterations += out.qp_iterations;
         if (out.time_total_ms > worst_ms) worst_ms = out.time_total_ms;
         total_ms += out.time_total_ms;
@@ -201,8 +203,8 @@ int main(int argc, char **argv)
     printf("{\"steps\": %ld, \"violations\": %ld, \"injected\": %ld, \"worst_ms\": %.3f, \"closest\": %.3f, "
            "\"stops\": {",
            steps, violations, injected, worst_ms, closest);
-    for (j = 1; j < N_REASONS; j++)
-        printf("\"%s\": %ld%s", S(stop_reason_message)(j), counts[j], j + 1 < N_REASONS ? ", " : "");
+    for (j = 1; j < n_reasons; j++)
+        printf("\"%s\": %ld%s", S(stop_reason_message)(j), counts[j], j + 1 < n_reasons ? ", " : "");
     printf("}, \"no_stop\": %ld, \"qp_iterations_mean\": %.2f, \"step_us\": %.3f, \"prepare_us\": %.3f",
            counts[0], (double)qp_iterations / (double)steps, 1e3 * total_ms / (double)steps,
            1e3 * prepare_ms / (double)steps);
