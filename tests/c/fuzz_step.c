@@ -49,6 +49,8 @@ static S(params) spec;   /* the spec's parameters */
 static S(input) in;
 static S(output) out;
 static double robot[4];  /* the robot's true state: the next step's measurement, unless jumped */
+/* Counts over a run, printed at exit: solver calls that return a command, and their stops by reason. */
+static unsigned long long calls, stops_by_reason[64];
 
 /* The harness's clock: every reading moves by tick ns. */
 static unsigned long long clock_now;
@@ -211,6 +213,8 @@ static void check(int bad, int clock_bad)
 {
     const S(params) *p = S(solver_params)(&solver);
     const int params_bad = S(params_check)(p) != 0;
+    calls++;
+    if (out.stop_reason >= 0 && out.stop_reason < 64) stops_by_reason[out.stop_reason]++;
     if (!isfinite((double)out.u0[0]) || !isfinite((double)out.u0[1]) || !isfinite((double)out.command[0]) ||
         !isfinite((double)out.command[1]))
         fail("a command that is not finite");
@@ -256,7 +260,24 @@ static void drive(void)
         robot[0] = robot[1] = robot[2] = robot[3] = 0.0;
 }
 
+static void report(void)
+{
+    int k;
+    fprintf(stderr, "fuzz_step: %llu solver calls (step, feedback, solve), stops by reason:", calls);
+    for (k = 0; k < U(STOP_REASON_COUNT) && k < 64; k++) fprintf(stderr, " %d:%llu", k, stops_by_reason[k]);
+    fprintf(stderr, "\n");
+}
+
+int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerInitialize(int *argc, char ***argv)
+{
+    (void)argc;
+    (void)argv;
+    atexit(report);
+    return 0;
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
