@@ -38,7 +38,10 @@
     X(STOP_NONFINITE, 5, nonfinite, "protective stop (C1): non-finite number in the solution") \
     X(STOP_HUMAN_TOO_CLOSE, 6, human_too_close, "protective stop (C2): a human is within d_h of the robot") \
     X(STOP_UNSAFE_PLAN, 7, unsafe_plan, "protective stop (C2): the planned path comes within d_h of a human") \
-    X(STOP_SEPARATION, 8, separation, "protective stop (speed and separation): at the commanded speed, braking after the reaction time would not stop the robot before a person closing in comes within d_h")
+    X(STOP_SEPARATION, 8, separation, "protective stop (speed and separation): at the commanded speed, braking after the reaction time would not stop the robot before a person closing in comes within d_h") \
+    X(STOP_COMMAND_BOUNDS, 9, command_bounds, "protective stop (command guard): the command was not finite or left the bounds of v, omega or a") \
+    X(STOP_CLOCK, 10, clock, "protective stop (clock fault): the clock ran backwards or did not advance over a step, so no deadline could be kept") \
+    X(STOP_STATE_JUMP, 11, state_jump, "protective stop: the measured state jumped further since the last step than the bounds allow")
 
 /* What a controller step ended with (controller.c): what the robot is doing, in one word. */
 #define HM_OUTCOME_TABLE(X) \

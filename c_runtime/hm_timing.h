@@ -24,7 +24,14 @@ HM_FUNC unsigned long long hm_clock_posix_ns(void *ctx)
 #endif
 #endif
 
-/* Milliseconds between two clock readings, in the solver's real type. */
-#define HM_ELAPSED_MS(t1, t0) ((hm_real)((t1) - (t0)) * HM_R(1e-6))
+/* Milliseconds between two clock readings, in the solver's real type; 0 for a reading 2^63 ns or more
+ * after t0 in the unsigned difference, i.e. one before it: a clock that ran backwards is a clock fault
+ * (ocp_nlp_clock_fault), and its times read 0 rather than 1.8e13 ms. */
+HM_FUNC hm_real hm_elapsed_ms(unsigned long long t1, unsigned long long t0)
+{
+    const unsigned long long d = t1 - t0;
+    return d >= (1ULL << 63) ? HM_R(0.0) : (hm_real)d * HM_R(1e-6);
+}
+#define HM_ELAPSED_MS(t1, t0) hm_elapsed_ms((t1), (t0))
 
 #endif /* HM_TIMING_H */

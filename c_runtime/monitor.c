@@ -126,3 +126,32 @@ HM_FUNC const char *monitor_stop_reason_message(int reason)
         return "unknown stop reason";
     }
 }
+
+static int monitor_within(hm_real x, const hm_real *bounds)
+{
+    /* false for NaN: the comparisons fail */
+    return x >= bounds[0] - HM_MONITOR_COMMAND_TOL * (HM_R(1.0) + hm_fabs(bounds[0])) &&
+           x <= bounds[1] + HM_MONITOR_COMMAND_TOL * (HM_R(1.0) + hm_fabs(bounds[1]));
+}
+
+HM_FUNC int monitor_command_ok(const hm_params *p, const hm_output *out)
+{
+    return monitor_within(out->command[0], p->v_bounds) && monitor_within(out->command[1], p->omega_bounds) &&
+           monitor_within(out->u0[0], p->a_bounds) && monitor_within(out->u0[1], p->omega_bounds);
+}
+
+HM_FUNC int monitor_state_follows(const hm_params *p, const hm_real *x_last, const hm_real *x)
+{
+    const hm_real dt2 = HM_R(2.0) * HM_R(HM_DT);
+    const hm_real v_max = hm_fmax(hm_fmax(hm_fabs(p->v_bounds[0]), hm_fabs(p->v_bounds[1])),
+                                  hm_fmax(hm_fabs(x_last[3]), hm_fabs(x[3])));
+    const hm_real a_max = hm_fmax(hm_fabs(p->a_bounds[0]), hm_fabs(p->a_bounds[1]));
+    const hm_real dx = x[0] - x_last[0], dy = x[1] - x_last[1];
+    const hm_real reach = dt2 * v_max + HM_MONITOR_JUMP_POSITION;
+    return dx * dx + dy * dy <= reach * reach && hm_fabs(x[3] - x_last[3]) <= dt2 * a_max + HM_MONITOR_JUMP_SPEED;
+}
+
+HM_FUNC int monitor_check_state(const hm_real *x)
+{
+    return monitor_state_ok(x);
+}

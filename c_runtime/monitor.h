@@ -66,4 +66,30 @@ HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_rea
 HM_FUNC int monitor_check_separation(const hm_input *in, const hm_params *p, hm_real v);
 HM_FUNC const char *monitor_stop_reason_message(int reason);
 
+/* The command guard, the last test of every step, solve and feedback that did not stop: 1 when the
+ * command (v = command[0], omega = command[1]) and u0 (a, omega) are finite and within the bounds of
+ * the parameters (v_bounds, omega_bounds, a_bounds), to HM_MONITOR_COMMAND_TOL (the QP's interior
+ * iterates keep the bounds only to its tolerance). A protective stop's command is a braking one by
+ * construction, and may lie above v_bounds while the robot slows down from above them. */
+#if defined(HM_REAL_IS_FLOAT)
+#define HM_MONITOR_COMMAND_TOL HM_R(1.0e-4)
+#else
+#define HM_MONITOR_COMMAND_TOL HM_R(1.0e-6)
+#endif
+HM_FUNC int monitor_command_ok(const hm_params *p, const hm_output *out);
+
+/* The state jump test: 1 when the measured state x can follow x_last, measured one step before, under
+ * the bounds: the position moved at most 2 dt max(|v| over v_bounds, x_last, x) + HM_MONITOR_JUMP_POSITION
+ * (two intervals: a missed period is no fault) and the speed changed by at most 2 dt max|a_bounds| +
+ * HM_MONITOR_JUMP_SPEED. The tolerances cover localisation corrections and odometry noise; the heading
+ * is not tested (a caller may wrap it). Only a solver that is warm compares: after a reset or a stop
+ * that starts cold there is no plan to be misled. */
+#define HM_MONITOR_JUMP_POSITION HM_R(0.5) /* m */
+#define HM_MONITOR_JUMP_SPEED HM_R(0.5)    /* m/s */
+HM_FUNC int monitor_state_follows(const hm_params *p, const hm_real *x_last, const hm_real *x);
+
+/* 1 when the state x (px, py, theta, v) is finite and within the magnitudes above: what a protective
+ * stop needs to brake from it. */
+HM_FUNC int monitor_check_state(const hm_real *x);
+
 #endif /* HM_MONITOR_H */

@@ -22,11 +22,30 @@ HM_FUNC int ocp_nlp_qp_usable(int status)
     return status == HM_QP_SOLVED || status == HM_QP_MAX_ITER;
 }
 
-/* Deadline hook of the QP iterations. */
+/* A clock reading 2^63 ns (292 years) or more after the start of the step, in the unsigned
+ * differences of hm_timing.h, is one from before it: the clock ran backwards. */
+#define OCP_NLP_CLOCK_BACKWARDS (1ULL << 63)
+
+/* Deadline hook of the QP iterations. A clock that runs backwards ends the QP too, and marks the
+ * step's clock fault (ocp_nlp_clock_fault). */
 HM_FUNC int ocp_nlp_deadline_passed(void *ctx)
 {
-    const hm_solver *s = (const hm_solver *)ctx;
-    return s->clock != 0 && s->clock(s->clock_ctx) - s->t_start > s->deadline_ns;
+    hm_solver *s = (hm_solver *)ctx;
+    unsigned long long elapsed;
+    if (s->clock == 0) return 0;
+    elapsed = s->clock(s->clock_ctx) - s->t_start;
+    if (elapsed >= OCP_NLP_CLOCK_BACKWARDS) {
+        s->clock_fault = 1;
+        return 1;
+    }
+    return elapsed > s->deadline_ns;
+}
+
+HM_FUNC int ocp_nlp_clock_fault(hm_solver *s, unsigned long long t_end)
+{
+    if (s->clock == 0) return 0;
+    if (t_end - s->t_start >= OCP_NLP_CLOCK_BACKWARDS) s->clock_fault = 1;
+    return s->clock_fault || (t_end == s->t_start && s->qp_solves > 0);
 }
 
 HM_FUNC void ocp_nlp_start_clock(hm_solver *s, unsigned long long t_start)
@@ -42,5 +61,6 @@ HM_FUNC void ocp_nlp_start_clock(hm_solver *s, unsigned long long t_start)
     whole = (unsigned long)ms;
     frac_ns = (unsigned long)((ms - (hm_real)whole) * HM_R(1e6));
     s->t_start = t_start;
+    s->clock_fault = 0;
     s->deadline_ns = (unsigned long long)whole * 1000000ULL + frac_ns;
 }

@@ -55,4 +55,11 @@ HM_FUNC int ocp_nlp_deadline_passed(void *ctx);
 /* A QP status whose solution is a step the SQP may take (solved, or at its iteration limit). */
 HM_FUNC int ocp_nlp_qp_usable(int status);
 
+/* The clock monitor, at the end of a step that solved, with the clock's last reading t_end: 1 when the
+ * clock ran backwards during the step (a reading before t_start, here or inside the QPs), or did not
+ * advance over it although a QP was solved (stuck: no deadline could ever fire). A clock must tick
+ * within one QP solve (microseconds; POSIX's and a Cortex-M SysTick's do). Without a clock: 0 (the
+ * deadline is off by the caller's choice, hm_timing.h). */
+HM_FUNC int ocp_nlp_clock_fault(hm_solver *s, unsigned long long t_end);
+
 #endif /* OCP_NLP_COMMON_H */

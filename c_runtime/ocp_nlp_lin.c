@@ -54,6 +54,34 @@ HM_FUNC void ocp_nlp_shift(hm_solver *s, const hm_input *in)
     ocp_nlp_simulate(s);
 }
 
+/* The guess moved into the bounds: omega clamped to omega_bounds, and each acceleration to a_bounds and
+ * to what keeps the next speed within v_bounds where a_bounds allow it (the model integrates v' = a:
+ * v_{n+1} = v_n + dt a_n), re-simulated from x_0. For the real-time iteration with a line search, which
+ * moves from its linearisation point only part of the way to the QP's solution: from a point outside
+ * the bounds (the repeated last control of a shifted plan) its plans stayed outside them (issue 22,
+ * item 10: speeds up to 1.3 m/s with v_max = 1). */
+HM_FUNC void ocp_nlp_project_guess(hm_solver *s)
+{
+    const hm_params *p = &s->params;
+    const hm_real dt = HM_R(HM_DT);
+    int n;
+    for (n = 0; n < HM_N; n++) {
+        const hm_real v = s->x[n][3];
+        const hm_real lo = hm_fmax(p->a_bounds[0], (p->v_bounds[0] - v) / dt);
+        const hm_real hi = hm_fmin(p->a_bounds[1], (p->v_bounds[1] - v) / dt);
+        hm_real a = s->u[n][0];
+        if (lo <= hi) {
+            a = hm_fmin(hm_fmax(a, lo), hi);
+        } else {
+            a = v > p->v_bounds[1] ? p->a_bounds[0] : p->a_bounds[1]; /* towards v_bounds at full rate */
+        }
+        s->u[n][0] = a;
+        s->u[n][1] = hm_fmin(hm_fmax(s->u[n][1], p->omega_bounds[0]), p->omega_bounds[1]);
+        hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], s->qp.A[n], s->qp.B[n]);
+    }
+    s->dyn_fresh = 1;
+}
+
 /* The safe fallback guess: brake to standstill within the acceleration bound, without turning,
  * from the measured state. Whenever braking keeps d_h, this guess satisfies every human row, so
  * the QP linearised at it (zero step feasible, rows convex) returns a plan that keeps d_h too. */

@@ -12,6 +12,8 @@ HM_FUNC void ocp_nlp_shift(hm_solver *s, const hm_input *in);
 
 /* The safe fallback guess: brake to standstill from the measured state, without turning. */
 HM_FUNC void ocp_nlp_init_braking(hm_solver *s, const hm_input *in);
+/* The guess moved into the bounds of a, omega and v and re-simulated (before a line-search RTI step). */
+HM_FUNC void ocp_nlp_project_guess(hm_solver *s);
 
 /* The cost of the slack that a row with value g needs (s = max(0, -g)), penalised by l1 and l2. */
 HM_FUNC hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2);

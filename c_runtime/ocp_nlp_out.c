@@ -75,18 +75,26 @@ HM_FUNC void ocp_nlp_report(const hm_solver *s, const hm_input *in, hm_output *o
     out->min_human_distance = ocp_nlp_min_human_distance(s, in);
 }
 
-/* Protective stop: brake to standstill within the acceleration bound, no turning; out's plan shows
- * the braking. Without a usable measured speed the command is the hardest braking. After a failure
- * (C1, unusable inputs) the next step starts cold, exactly as a fresh solver; after a C2 stop the
- * plan is kept, so that the next steps go on improving it (a cold start would put the unsafe
- * straight-line guess back every time). */
+/* Protective stop: brake to standstill at the configured rate (a_bounds, whenever their row of the
+ * parameter table holds, even with another row broken; else the spec's a_bounds), no turning; out's
+ * plan shows the braking from the measured state. Without a usable measured state the command is
+ * v = 0 and u0 the hardest braking. After a failure (C1, unusable inputs, the command guard, the
+ * clock, a state jump) the next step starts cold, exactly as a fresh solver; after a C2 stop the plan
+ * is kept, so that the next steps go on improving it (a cold start would put the unsafe straight-line
+ * guess back every time). */
 HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output *out, int reason)
 {
-    const int params_ok = monitor_check_params(&s->params);
-    const hm_real a_min = params_ok ? s->params.a_bounds[0] : HM_R(-1.0);
-    const hm_real a_max = params_ok ? s->params.a_bounds[1] : HM_R(1.0);
-    const int x0_ok = params_ok && monitor_check_input(in, 1);
-    int n, i;
+    hm_params spec_params;
+    const hm_params *brake = &s->params;
+    hm_real a_min, a_max;
+    int x0_ok, n, i;
+    if (!hm_params_brake_ok(brake)) {
+        hm_params_default(&spec_params);
+        brake = &spec_params;
+    }
+    a_min = brake->a_bounds[0];
+    a_max = brake->a_bounds[1];
+    x0_ok = monitor_check_state(in->x0);
     out->stop = 1;
     out->stop_reason = reason;
     if (!x0_ok) {
@@ -108,7 +116,7 @@ HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output
             out->u[n][1] = HM_R(0.0);
             hm_model_dynamics(out->x[n], out->u[n], out->x[n + 1], A, B);
         }
-        for (n = 0; n <= HM_N; n++) {
+        for (n = 0; n <= HM_N && monitor_check_input(in, 1); n++) {
             for (j = 0; j < ocp_nlp_clamp_humans(in); j++) {
                 const hm_real dx = out->x[n][0] - in->humans_now[j][0];
                 const hm_real dy = out->x[n][1] - in->humans_now[j][1];
@@ -124,6 +132,26 @@ HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output
     s->prepared = 0;
     if (reason != HM_STOP_UNSAFE_PLAN && reason != HM_STOP_HUMAN_TOO_CLOSE && reason != HM_STOP_SEPARATION)
         s->warm = 0;
+}
+
+/* The end of every step, feedback and solve: the plan (reason HM_STOP_NONE) or the protective stop.
+ * A plan passes the command guard first (monitor_command_ok): a command that is not finite or leaves
+ * the bounds is a protective stop of its own reason, and the next step starts cold. The measured
+ * state is remembered for the next step's jump test (monitor_state_follows). */
+HM_FUNC void ocp_nlp_finish(hm_solver *s, const hm_input *in, hm_output *out, int reason)
+{
+    int i;
+    if (reason == HM_STOP_NONE) {
+        ocp_nlp_report(s, in, out);
+        if (monitor_command_ok(&s->params, out)) reason = -1;
+        else {
+            reason = HM_STOP_COMMAND_BOUNDS;
+            s->ipm_ws.warm.ready = 0;
+        }
+    }
+    if (reason >= 0) ocp_nlp_protective_stop(s, in, out, reason);
+    if (monitor_check_state(in->x0))
+        for (i = 0; i < HM_NX; i++) s->x0_last[i] = in->x0[i];
 }
 
 HM_FUNC void ocp_nlp_clear_output(hm_output *out)
@@ -143,12 +171,15 @@ HM_FUNC void ocp_nlp_clear_output(hm_output *out)
     out->min_human_distance = HM_INF;
 }
 
-/* The checks that come before any solving; returns the stop reason or HM_STOP_NONE. */
+/* The checks that come before any solving; returns the stop reason or HM_STOP_NONE. A warm solver's
+ * measured state must follow the last one (monitor_state_follows): a jump beyond what the bounds allow
+ * would have the plan of another place shifted and linearised. */
 HM_FUNC int ocp_nlp_check_before(const hm_solver *s, const hm_input *in)
 {
     if (!monitor_check_params(&s->params)) return HM_STOP_INVALID_PARAMS;
     if (!monitor_check_input(in, 1)) return HM_STOP_INVALID_INPUT;
     if (monitor_distance_now(in) < s->params.d_h) return HM_STOP_HUMAN_TOO_CLOSE;
+    if (s->warm && !monitor_state_follows(&s->params, s->x0_last, in->x0)) return HM_STOP_STATE_JUMP;
     return HM_STOP_NONE;
 }
 

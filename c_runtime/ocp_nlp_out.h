@@ -20,6 +20,9 @@ HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output
 /* out as before any solving: no stop, status HM_STATUS_SKIPPED, counts and residuals zero. */
 HM_FUNC void ocp_nlp_clear_output(hm_output *out);
 
+/* The plan after the command guard, or the protective stop of reason (see ocp_nlp_out.c). */
+HM_FUNC void ocp_nlp_finish(hm_solver *s, const hm_input *in, hm_output *out, int reason);
+
 /* The checks that come before any solving; returns the stop reason or HM_STOP_NONE. */
 HM_FUNC int ocp_nlp_check_before(const hm_solver *s, const hm_input *in);
 

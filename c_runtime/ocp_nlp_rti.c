@@ -40,11 +40,18 @@ static int ocp_nlp_params_changed(const hm_solver *s)
 static void ocp_nlp_rti_prepare(hm_solver *s, const hm_input *in)
 {
     const unsigned long long t0 = ocp_nlp_now(s);
+    /* Prepared already (a preparation not yet followed by its feedback, then step() or prepare()
+     * again): the plan was shifted once; it is linearised again with these inputs, not shifted twice. */
+    const int again = s->prepared;
     s->prepared = 0;
     /* Nothing is computed from unusable data; the feedback phase turns it into a stop. A cold
      * start reads x0 (the caller's guess) already here. */
     if (monitor_check_params(&s->params) && monitor_check_input(in, !s->warm)) {
-        ocp_nlp_shift(s, in);
+        if (!again) {
+            ocp_nlp_shift(s, in);
+            /* a line search stays between this point and the QP's solution: start it within the bounds */
+            if (s->params.line_search) ocp_nlp_project_guess(s);
+        }
         /* exact_hessian: the Lagrangian's Hessian at the shifted multipliers of the last QP (a cold
          * start has none: Gauss-Newton). With the paper's zero control weights and a far goal the
          * Gauss-Newton model misses the costate-weighted curvature of the dynamics, and its full steps
@@ -136,6 +143,8 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
             }
             if (reason == HM_STOP_NONE && ocp_nlp_deadline_passed(s)) reason = HM_STOP_DEADLINE;
         }
+        /* a clock that ran backwards or stood still: the deadline could not be kept */
+        if (ocp_nlp_clock_fault(s, ocp_nlp_now(s))) reason = HM_STOP_CLOCK;
     } else {
         s->prepared = 0;
         t_feedback = ocp_nlp_now(s);
@@ -145,11 +154,7 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
      * iterate is the retry's, whose linearisation the plan has left; a stop before solving leaves one
      * from an older step */
     if (reason != HM_STOP_NONE) s->ipm_ws.warm.ready = 0;
-    if (reason == HM_STOP_NONE) {
-        ocp_nlp_report(s, in, out);
-    } else {
-        ocp_nlp_protective_stop(s, in, out, reason);
-    }
+    ocp_nlp_finish(s, in, out, reason); /* the command guard, or the stop */
     out->qp_solves = s->qp_solves;
     out->time_prepare_ms = s->time_prepare_ms;
     out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t_feedback);

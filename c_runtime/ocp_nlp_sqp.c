@@ -18,6 +18,7 @@
 
 HM_FUNC void ocp_nlp_sqp_init(hm_solver *s, const hm_params *params)
 {
+    int i;
     s->params = *params;
     ocp_qp_ipm_arg_set_default(&s->ipm_arg);
     /* Every QP of the SQP is bounded by construction (box bounds on both inputs of every stage, the
@@ -32,6 +33,7 @@ HM_FUNC void ocp_nlp_sqp_init(hm_solver *s, const hm_params *params)
     s->clock = 0;
 #endif
     s->clock_ctx = 0;
+    for (i = 0; i < HM_NX; i++) s->x0_last[i] = HM_R(0.0);
     ocp_nlp_sqp_reset(s);
 }
 
@@ -49,19 +51,27 @@ HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
     s->cost = HM_R(0.0);
     s->time_prepare_ms = HM_R(0.0);
     s->screen_radius[0] = HM_INF;
+    s->clock_fault = 0;
+    /* x0_last is kept: the last measured state stays what it was (a solver made warm from outside, as
+     * the controller's nudged recovery does, compares with it) */
 }
 
-/* timed: under the deadline of params.deadline_ms from t0 (polled inside the QPs and between the
- * iterations; passing it is a protective stop), as a recovery inside a control period needs. */
+/* Under the same monitors as the real-time iteration: the inputs and parameters before, the deadline of
+ * params.deadline_ms from t0 (polled inside the QPs and between the iterations), every QP solved (one
+ * stopped at its iteration limit, infeasible or failed ends the SQP, its iterate not applied), the
+ * clock, C1 / C2 on the plan and the command guard; each failure a protective stop. max_iter < 1 or a
+ * tolerance that is not a positive finite number is an invalid input: nothing is solved. */
 static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
-                               int timed, unsigned long long t0)
+                               unsigned long long t0)
 {
     int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER, reason, late = 0;
     ocp_nlp_clear_output(out);
     s->qp_solves = 0;
     reason = ocp_nlp_check_before(s, in);
+    if (reason == HM_STOP_NONE && (max_iter < 1 || !(tol > HM_R(0.0) && tol < HM_INF)))
+        reason = HM_STOP_INVALID_INPUT;
     if (reason != HM_STOP_NONE) {
-        ocp_nlp_protective_stop(s, in, out, reason);
+        ocp_nlp_finish(s, in, out, reason);
         out->time_total_ms = out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
         out->time_prepare_ms = HM_R(0.0);
         return out->status;
@@ -79,13 +89,11 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
     s->ipm_arg.recurrence = 0;
     /* and all of them from the cold start (keeping none, so the next RTI step starts cold too) */
     s->ipm_arg.warm_mu = HM_R(0.0);
-    if (timed) {
-        ocp_nlp_start_clock(s, t0);
-        s->ipm_arg.should_stop = ocp_nlp_deadline_passed;
-        s->ipm_arg.stop_ctx = s;
-    }
+    ocp_nlp_start_clock(s, t0);
+    s->ipm_arg.should_stop = ocp_nlp_deadline_passed;
+    s->ipm_arg.stop_ctx = s;
     for (k = 0; k < max_iter; k++) {
-        if (timed && ocp_nlp_deadline_passed(s)) {
+        if (ocp_nlp_deadline_passed(s)) {
             late = 1;
             break;
         }
@@ -97,7 +105,7 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
             break;
         }
         qp_status = ocp_nlp_qp_line_search_step(s, in, tol, 0, &out->qp_iterations);
-        if (!ocp_nlp_qp_usable(qp_status)) {
+        if (qp_status != HM_QP_SOLVED) { /* the iteration limit too: not a solution */
             status = HM_STATUS_QP_FAILED;
             late = qp_status == HM_QP_TIMEOUT;
             break;
@@ -128,10 +136,8 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
     } else {
         reason = ocp_nlp_check_plan(s, in);
     }
-    if (reason == HM_STOP_NONE)
-        ocp_nlp_report(s, in, out);
-    else
-        ocp_nlp_protective_stop(s, in, out, reason);
+    if (ocp_nlp_clock_fault(s, ocp_nlp_now(s))) reason = HM_STOP_CLOCK;
+    ocp_nlp_finish(s, in, out, reason); /* the command guard, or the stop */
     out->time_prepare_ms = HM_R(0.0);
     out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
     out->time_total_ms = out->time_feedback_ms;
@@ -140,13 +146,13 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
 
 HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol)
 {
-    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, 0, ocp_nlp_now(s));
+    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, ocp_nlp_now(s));
 }
 
 HM_FUNC int ocp_nlp_sqp_solve_timed(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
                                     unsigned long long t0)
 {
-    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, 1, t0);
+    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, t0);
 }
 
 HM_FUNC const char *ocp_nlp_status_message(int status)

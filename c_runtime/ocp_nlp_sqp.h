@@ -9,9 +9,11 @@
 
 HM_FUNC void ocp_nlp_sqp_init(hm_solver *s, const hm_params *params);
 HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s);
+/* The full SQP, under the monitors of the real-time iteration (inputs, parameters, every QP solved, the
+ * deadline of params.deadline_ms from now, the clock, C1 / C2, the command guard): a failure of any is a
+ * protective stop; max_iter < 1 or tol not positive and finite an invalid input. */
 HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol);
-/* The same under the step's deadline (params.deadline_ms from the clock reading t0): a late SQP ends
- * in a protective stop for the deadline. */
+/* The same with the deadline counted from the clock reading t0 (a recovery inside a control period). */
 HM_FUNC int ocp_nlp_sqp_solve_timed(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
                                     unsigned long long t0);
 HM_FUNC const char *ocp_nlp_status_message(int status);

@@ -49,4 +49,8 @@ typedef struct HM_NS(solver) {
     /* The parameters the current preparation used, byte for byte: a feedback under changed ones
      * (new bounds, weights, ...) prepares again instead of solving a QP built with the old ones. */
     HM_NS(params) params_prepared;
+    /* The measured state of the last step (the state jump test of a warm solver, monitor.h). */
+    HM_REAL x0_last[HM_NX];
+    /* 1: the clock ran backwards during this step (ocp_nlp_deadline_passed): a clock fault. */
+    int clock_fault;
 } HM_NS(solver);

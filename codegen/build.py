@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import shutil
+import struct
 import subprocess
 import sys
 from collections.abc import Callable
@@ -96,5 +98,81 @@ def build(solver_dir: str | Path, *, cc: str | None = None, cflags: str | None =
         tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-40:])
         raise BuildError(f"building {d} failed (make exit {proc.returncode}):\n{tail}")
     lib = library_path(d)
+    record_library(lib)
     say(f"[humanmpc] built {lib}")
     return lib
+
+
+# -- the library's integrity, checked by humanmpc.load before dlopen ---------------------------------------
+# A truncated library mapped by dlopen crashes the process with SIGBUS when a page past its end is touched
+# (issue 22, item 6). build() records the size and SHA-256 of what it built next to it; load() compares,
+# and checks the ELF file's own structure (its segments and section table lie inside the file) whoever
+# built it.
+
+
+def record_path(lib: Path) -> Path:
+    return lib.with_name(lib.name + ".record.json")
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with path.open("rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def record_library(lib: Path) -> None:
+    """Write the size and SHA-256 of the library build() just made (build/lib<name>.so.record.json)."""
+    record_path(lib).write_text(json.dumps({"size": lib.stat().st_size, "sha256": _sha256(lib)}) + "\n")
+
+
+class LibraryIntegrityError(RuntimeError):
+    """A library that is not the one that was built, or not a whole ELF file: never handed to dlopen."""
+
+
+def check_elf(lib: Path) -> None:
+    """The ELF header, every loaded segment and the section table lie inside the file (a truncated .so fails)."""
+    data = lib.read_bytes()
+    size = len(data)
+    if size < 64 or data[:4] != b"\x7fELF" or data[4] not in (1, 2) or data[5] not in (1, 2):
+        raise LibraryIntegrityError(f"{lib} is not an ELF shared library ({size} bytes)")
+    wide, order = data[4] == 2, "<" if data[5] == 1 else ">"
+    if wide:
+        phoff, shoff = struct.unpack_from(order + "QQ", data, 32)
+        phentsize, phnum, shentsize, shnum = struct.unpack_from(order + "HHHH", data, 54)
+    else:
+        phoff, shoff = struct.unpack_from(order + "II", data, 28)
+        phentsize, phnum, shentsize, shnum = struct.unpack_from(order + "HHHH", data, 42)
+    if phoff + phentsize * phnum > size or shoff + shentsize * shnum > size:
+        raise LibraryIntegrityError(f"{lib} is cut short: its headers reach beyond its {size} bytes")
+    for k in range(phnum):
+        at = phoff + k * phentsize
+        if wide:
+            p_type, = struct.unpack_from(order + "I", data, at)
+            p_offset, = struct.unpack_from(order + "Q", data, at + 8)
+            p_filesz, = struct.unpack_from(order + "Q", data, at + 32)
+        else:
+            p_type, p_offset = struct.unpack_from(order + "II", data, at)
+            p_filesz, = struct.unpack_from(order + "I", data, at + 16)
+        if p_type == 1 and p_offset + p_filesz > size:  # PT_LOAD
+            raise LibraryIntegrityError(f"{lib} is cut short: a loaded segment ends at byte {p_offset + p_filesz}, "
+                                        f"the file at {size}")
+
+
+def check_library(lib: Path) -> None:
+    """What load() checks before dlopen: the ELF structure, and the size and hash build() recorded, if it did."""
+    check_elf(lib)
+    rec = record_path(lib)
+    if not rec.is_file():
+        return
+    try:
+        expected = json.loads(rec.read_text())
+        want_size, want_hash = int(expected["size"]), str(expected["sha256"])
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        raise LibraryIntegrityError(f"{rec} is not a library record ({err!r}); rebuild the package") from None
+    got_size = lib.stat().st_size
+    if got_size != want_size or _sha256(lib) != want_hash:
+        raise LibraryIntegrityError(
+            f"{lib} is not the library that was built ({got_size} bytes, recorded {want_size}, or another "
+            f"SHA-256): rebuild it with `humanmpc-gen build {lib.parent.parent}`")

@@ -111,7 +111,7 @@ def add_generator_commands(sub: argparse._SubParsersAction) -> None:
                        description="Generate the C solver package of SPEC (or of the built-in default spec). "
                        "The folder is written atomically: on failure nothing is left behind.")
     p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
-    p.add_argument("-o", "--output", type=Path, help="output folder (default: generated/<name>)")
+    p.add_argument("-o", "--output", type=output_dir, help="output folder (default: generated/<name>)")
     p.add_argument("--force", action="store_true", help="replace an existing generated folder")
     p.set_defaults(func=_cmd_generate)
 
@@ -161,6 +161,19 @@ def positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"{value} must be an integer >= 1")
     return value
+
+
+def output_dir(text: str) -> Path:
+    """argparse type: a folder to write into, checked before any work: it is a folder or can become one
+    (no part of it is a file). A file in the way raised a traceback once the command got to writing."""
+    path = Path(text)
+    for part in (path, *path.parents):
+        if part.exists():
+            if not part.is_dir():
+                what = "is a file" if part == path else f"lies under {str(part)!r}, which is a file"
+                raise argparse.ArgumentTypeError(f"{text!r} {what}: it must be a folder, or a path that can become one")
+            break
+    return path
 
 
 # What the generator's commands raise for a user's mistake or a failed tool: reported in one line.

@@ -177,6 +177,11 @@ class Param:
         return row
 
 
+# The weakest braking a protective stop may be configured with [m/s^2]: 1 m/s stopped in at most 10 s. A
+# lower acceleration bound of 0 (or -1e-300) let a stop command a = 0: the robot drove on at its speed
+# with a person ahead (issue 22, item 1). The spec, the C check and Python all apply this row.
+BRAKING_MIN = 0.1
+
 # Caps: far beyond any robot, but finite, so that no value overflows the solver's arithmetic.
 _WEIGHT = Range(0.0, 1e9)
 _DIST = Range(0.0, 100.0)
@@ -217,13 +222,14 @@ PARAMS: tuple[Param, ...] = (
           problem=True, paper=100.0),
     Param("slack_l2", "obstacle.slack_l2", "real", 100.0, "L2 penalty on the obstacle slack (0.5*l2*s^2)",
           valid=_WEIGHT, problem=True),
-    # The bounds must admit the protective stop: standstill (v = 0), braking (a < 0) and no turning.
+    # The bounds must admit the protective stop: standstill (v = 0), braking and no turning. Braking means a
+    # real deceleration, not a lower bound a hair below 0: a_min <= -BRAKING_MIN (docs/reliability.md).
     Param("v_bounds", "bounds.v", "interval", (0.0, 1.0), "forward speed", unit="m/s", size=2,
           lower=Range(-100.0, 0.0), upper=Range(0.0, 100.0, lo_open=True), problem=True,
           reason="the robot must be able to come to a standstill, and to move"),
     Param("a_bounds", "bounds.a", "interval", (-1.0, 1.0), "acceleration", unit="m/s^2", size=2,
-          lower=Range(-100.0, 0.0, hi_open=True), upper=Range(0.0, 100.0, lo_open=True), problem=True,
-          reason="a protective stop must be able to brake, and the robot to speed up"),
+          lower=Range(-100.0, -BRAKING_MIN), upper=Range(0.0, 100.0, lo_open=True), problem=True,
+          reason="a protective stop must be able to brake, by at least 0.1 m/s^2, and the robot to speed up"),
     Param("omega_bounds", "bounds.omega", "interval", (-1.5, 1.5), "turn rate", unit="rad/s", size=2,
           lower=Range(-100.0, 0.0), upper=Range(0.0, 100.0), problem=True,
           reason="the robot must be able to hold its heading"),

@@ -1,7 +1,8 @@
 """cffi bindings of a generated solver: load the shared library and call it on numpy arrays.
 
 ABI mode (dlopen) with the declarations the generator wrote next to the C code, so loading needs
-no compiler beyond the one that built the library. The library's spec hash and sizes are checked
+no compiler beyond the one that built the library. Before dlopen the library must be a whole ELF file
+and, when humanmpc built it, the one it recorded (size and SHA-256); its spec hash and sizes are checked
 against the package's manifest before anything is called.
 """
 
@@ -18,7 +19,7 @@ import cffi
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .codegen.build import build, is_stale
+from .codegen.build import LibraryIntegrityError, build, check_library, is_stale
 from .codegen.params import Param
 from .codegen.spec import IDENT_RE
 from .solver import Solver
@@ -130,6 +131,11 @@ def load(solver_dir: str | Path, *, build_if_needed: bool = True) -> Solver:
     except (OSError, cffi.CDefError) as err:
         raise LoadError(f"{d}: {name}_cffi.h cannot be read as the package's declarations ({err}); "
                         "regenerate the package") from None
+    # a truncated or altered library would crash the process inside dlopen (SIGBUS): checked before
+    try:
+        check_library(lib_path)
+    except (OSError, LibraryIntegrityError) as err:
+        raise LoadError(f"{d}: {err}") from None
     lib = ffi.dlopen(str(lib_path))
     got_hash = ffi.string(getattr(lib, f"{name}_spec_hash")()).decode()
     if got_hash != manifest["spec_hash"]:

@@ -164,7 +164,10 @@ class Solver:
     def solve(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None = None,
               humans_pred: ArrayLike | None = None, obstacle: ArrayLike | None = None, *,
               max_iter: int = 100, tol: float = 1e-8) -> StepResult:
-        """Full SQP to the KKT tolerance, from the current plan (after reset(): a cold start)."""
+        """Full SQP to the KKT tolerance, from the current plan (after reset(): a cold start), under the
+        monitors of ``step``: the deadline (``deadline_ms``: raise it for a reference solve), every QP
+        solved (one stopped at its iteration limit ends the SQP in a stop, reason qp_failed), the clock,
+        C1 / C2 and the command guard."""
         if max_iter < 1:
             raise ValueError(f"max_iter must be >= 1, got {max_iter}")
         if not (math.isfinite(tol) and tol > 0):

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import shutil
+import subprocess
+import sys
 import threading
 from pathlib import Path
 
@@ -83,3 +85,42 @@ def test_a_manifest_that_is_not_json_is_a_load_error(small_dir: Path, tmp_path: 
     (d / "manifest.json").write_text(json.dumps({"name": "x; system()"}))
     with pytest.raises(humanmpc.LoadError, match="not a C identifier"):
         humanmpc.load(d)
+
+
+def _load_in_a_child(solver_dir: Path) -> subprocess.CompletedProcess[str]:
+    """load() in another process: on the old binding a truncated library killed it with SIGBUS."""
+    code = ("import sys, humanmpc\n"
+            "try:\n    humanmpc.load(sys.argv[1], build_if_needed=False)\n"
+            "except humanmpc.LoadError as err:\n    print(err); sys.exit(3)\n")
+    return subprocess.run([sys.executable, "-c", code, str(solver_dir)], capture_output=True, text=True,
+                          timeout=120, check=False)
+
+
+@pytest.mark.parametrize("keep", [0.5, 0.95])
+def test_a_truncated_library_is_refused_before_dlopen(small_dir: Path, tmp_path: Path, keep: float) -> None:
+    """A library cut short (a full disk, an interrupted copy) gave SIGBUS inside dlopen: now a LoadError
+    that names it, whoever built it (the ELF file's own segments), and before that build()'s record."""
+    d = tmp_path / "safety"
+    shutil.copytree(small_dir, d)
+    lib = d / "build" / "libsafety.so"
+    data = lib.read_bytes()
+    for recorded in (True, False):
+        if not recorded:
+            (d / "build" / "libsafety.so.record.json").unlink()
+        lib.write_bytes(data[: int(len(data) * keep)])
+        proc = _load_in_a_child(d)
+        assert proc.returncode == 3, (proc.returncode, proc.stderr[-2000:])
+        assert "libsafety.so" in proc.stdout and ("cut short" in proc.stdout or "not the library" in proc.stdout)
+
+
+def test_an_altered_library_of_the_same_size_is_refused(small_dir: Path, tmp_path: Path) -> None:
+    d = tmp_path / "safety"
+    shutil.copytree(small_dir, d)
+    lib = d / "build" / "libsafety.so"
+    data = bytearray(lib.read_bytes())
+    data[-10] ^= 0xFF
+    lib.write_bytes(bytes(data))
+    proc = _load_in_a_child(d)
+    assert proc.returncode == 3 and "is not the library that was built" in proc.stdout, proc.stdout + proc.stderr
+    lib.write_bytes(bytes(data[:-10]) + bytes([data[-10] ^ 0xFF]) + bytes(data[-9:]))
+    assert _load_in_a_child(d).returncode == 0

@@ -6,10 +6,7 @@ import json
 import subprocess
 from pathlib import Path
 
-import numpy as np
 import pytest
-
-import humanmpc
 
 from .conftest import make_solver, require_tool
 
@@ -78,25 +75,53 @@ def test_profile_build_times_every_qp_part_and_the_parts_fit_in_the_step(soak_di
     assert sum(timed.values()) + summary["prepare_us"] <= 1.02 * summary["step_us"] + 1.0, summary
 
 
-def test_libfuzzer_over_the_step_function_finds_nothing(tmp_path: Path) -> None:
-    clang = require_tool("clang")
-    d = make_solver(tmp_path, {"name": "fuzz", "horizon": {"N": 12, "T": 1.2}, "humans": {"max": 4}})
-    exe = tmp_path / "fuzz_step"
-    cmd = [clang, *STRICT, "-O1", "-g", "-fsanitize=fuzzer,address,undefined", "-fno-sanitize-recover=all",
-           '-DSOLVER_HEADER="fuzz.h"', "-DSOLVER_PREFIX=fuzz_", "-I", str(d), str(C_DIR / "fuzz_step.c"),
-           str(d / "fuzz.c"), str(d / "fuzz_model.c"), "-lm", "-o", str(exe)]
+def build_fuzzer(solver_dir: Path, exe: Path) -> Path:
+    """tests/c/fuzz_step.c over a generated solver, with libFuzzer, ASan and UBSan (docs/reliability.md)."""
+    name = solver_dir.name
+    cmd = [require_tool("clang"), *STRICT, "-O1", "-g", "-fsanitize=fuzzer,address,undefined",
+           "-fno-sanitize-recover=all", f'-DSOLVER_HEADER="{name}.h"', f"-DSOLVER_PREFIX={name}_",
+           f"-DSOLVER_UPREFIX={name.upper()}_", "-I", str(solver_dir), str(C_DIR / "fuzz_step.c"),
+           str(solver_dir / f"{name}.c"), str(solver_dir / f"{name}_model.c"), "-lm", "-o", str(exe)]
     proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
     assert proc.returncode == 0, proc.stderr
-    # Seed corpus: a valid step's input, from the Python binding's own struct.
-    solver = humanmpc.load(d)
+    return exe
+
+
+def test_libfuzzer_over_step_feedback_solve_reset_parameters_and_clock_finds_nothing(tmp_path: Path) -> None:
+    """25 s of the fuzz target: sequences of step / prepare + feedback / solve / reset / parameter writes /
+    clock faults, under the oracle of tests/c/fuzz_step.c (command finite, within the bounds or a braking
+    stop at the configured rate, every bad input, parameter or clock a stop with its reason)."""
+    d = make_solver(tmp_path, {"name": "fuzz", "horizon": {"N": 12, "T": 1.2}, "humans": {"max": 4}}, built=False)
+    exe = build_fuzzer(d, tmp_path / "fuzz_step")
     corpus = tmp_path / "corpus"
     corpus.mkdir()
-    solver._load_inputs([0, 0, 0.1, 0.5], [5, 0, 0, 0.8], np.array([[2.0, 1.0]]),
-                        np.tile([[2.0, 1.0]], (13, 1, 1)), [3.0, -1.0])
-    (corpus / "valid").write_bytes(bytes(solver._ffi.buffer(solver._in)))
+    # seeds: a few steps among people, a solve, a clock that stands still, a parameter written
+    (corpus / "steps").write_bytes(bytes([0, 2, 1] + [1] * 120) * 3)
+    (corpus / "solve").write_bytes(bytes([5, 12, 1, 0, 0] + [1] * 120))
+    (corpus / "clock").write_bytes(bytes([9, 1, 0, 2, 1] + [1] * 120))
+    (corpus / "param").write_bytes(bytes([7, 8, 0, 1, 0, 0, 0, 0, 2, 1] + [1] * 120))
     proc = subprocess.run([str(exe), "-max_total_time=25", "-seed=1", "-rss_limit_mb=2048",
                            "-print_final_stats=1", str(corpus)],
                           capture_output=True, text=True, timeout=300, check=False, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr[-4000:]
     executed = [line for line in proc.stderr.splitlines() if "stat::number_of_executed_units" in line]
     assert executed and int(executed[0].split(":")[-1]) > 1000
+
+
+def test_the_fuzz_oracle_catches_a_stop_that_does_not_brake_at_the_configured_rate(tmp_path: Path) -> None:
+    """The oracle can fail: a runtime whose stop ignores a_bounds (full braking at -1 m/s^2, the runtime
+    before issue 22) is reported on the seed that sets a_min = -0.5 and breaks a goal."""
+    d = make_solver(tmp_path, {"name": "fzo", "horizon": {"N": 12, "T": 1.2}, "humans": {"max": 4},
+                               "bounds": {"a": [-0.5, 1.0]}}, built=False)
+    source = (d / "runtime" / "ocp_nlp_out.c").read_text()
+    broken = source.replace("a_min = brake->a_bounds[0];", "a_min = HM_R(-1.0);")
+    assert broken != source
+    (d / "runtime" / "ocp_nlp_out.c").write_text(broken)
+    exe = build_fuzzer(d, tmp_path / "fuzz_oracle")
+    seed = tmp_path / "seed"
+    # one step: a measured speed of 0.5 stopped for a goal made NaN (an attack byte 0x00 then mode 0)
+    seed.write_bytes(bytes([0, 0, 1, 0, 0, 0] + [1] * 200))
+    proc = subprocess.run([str(exe), "-runs=2000", "-seed=1", str(seed)], capture_output=True, text=True,
+                          timeout=300, check=False, cwd=tmp_path)
+    assert proc.returncode != 0 and "a stop that does not brake at the configured rate" in proc.stderr, \
+        proc.stderr[-2000:]

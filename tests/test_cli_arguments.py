@@ -33,6 +33,8 @@ def test_a_figure_name_matplotlib_cannot_write_is_refused_before_the_episode_run
     (["bench", "--steps", "-5"], "--steps", "negative"),
     (["firmware", "somewhere", "--seed", "-2"], "--seed", "negative"),
     (["demo", "--seed", "-3"], "--seed", "negative"),
+    (["firmware", "somewhere", "--steps", "-4"], "--steps", "negative"),
+    (["firmware", "somewhere", "--humans", "-1"], "--humans", "negative"),
 ])
 def test_a_bad_number_names_its_option(argv: list[str], option: str, why: str,
                                        capsys: pytest.CaptureFixture[str]) -> None:
@@ -41,3 +43,25 @@ def test_a_bad_number_names_its_option(argv: list[str], option: str, why: str,
     assert info.value.code == 2
     err = capsys.readouterr().err
     assert f"argument {option}:" in err and why in err
+
+
+@pytest.mark.parametrize(("argv", "option"), [
+    (["generate", "-o", "{file}/sub"], "-o/--output"),
+    (["evaluate", "--out", "{file}"], "--out"),
+    (["demo", "--out", "{file}/x"], "--out"),
+    (["bench", "--out", "{file}"], "--out"),
+    (["bench", "--compare", "--compare-out", "{file}"], "--compare-out"),
+])
+def test_an_output_folder_that_is_a_file_is_refused_before_any_work(argv: list[str], option: str, tmp_path: Path,
+                                                                     capsys: pytest.CaptureFixture[str]) -> None:
+    """A file where a command's output folder goes raised a traceback (FileExistsError, NotADirectoryError)
+    once the command got to writing; now argparse names the option before anything runs."""
+    f = tmp_path / "afile"
+    f.write_text("")
+    t0 = time.perf_counter()
+    with pytest.raises(SystemExit) as info:
+        cli.main([a.format(file=f) for a in argv])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"argument {option}:" in err and "it must be a folder" in err and str(f) in err
+    assert time.perf_counter() - t0 < 5.0

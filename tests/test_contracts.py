@@ -140,3 +140,30 @@ def test_step_results_name_their_codes_from_the_table(paper: humanmpc.Solver) ->
     r = paper.step([0, 0, 0, 0.5], [5, 0, 0, 0.8], [[0.2, 0.0]], np.tile([[0.2, 0.0]], (paper.dims.N + 1, 1, 1)))
     assert r.stop and r.reason == "human_too_close" and r.status_name == "skipped"
     paper.reset()
+
+
+@pytest.mark.parametrize("a_min", [0.0, -1e-300, -0.05, -0.0999])
+def test_a_lower_acceleration_bound_that_cannot_brake_is_refused_by_the_spec_c_and_python(
+        paper: humanmpc.Solver, a_min: float) -> None:
+    """Issue 22, item 1: a protective stop must brake by a meaningful margin (a_min <= -0.1 m/s^2); with
+    a_min = 0 or -1e-300 a stop commanded a = 0 and the robot drove on with a person 0.3 m ahead."""
+    p = next(p for p in PARAMS if p.name == "a_bounds")
+    assert "-100 <= lower <= -0.1" in p.rule
+    with pytest.raises(SpecError, match=re.escape(p.rule)):
+        resolve_spec({"bounds": {"a": [a_min, 1.0]}})
+    params = c_params(paper)
+    params.a_bounds = [a_min, 1.0]
+    assert getattr(paper._lib, f"{paper.name}_params_check")(params) == PARAMS.index(p) + 1
+    with pytest.raises(ValueError, match=re.escape(p.rule)):
+        paper.set_params(a_bounds=[a_min, 1.0])
+
+
+def test_the_weakest_allowed_braking_brakes_a_protective_stop(paper_dir: Path) -> None:
+    """a_min = -0.1 is accepted everywhere, and a stop for a person 0.3 m ahead then decelerates by it."""
+    assert resolve_spec({"bounds": {"a": [-0.1, 1.0]}}).bounds.a == (-0.1, 1.0)
+    solver = humanmpc.load(paper_dir)
+    solver.set_params(a_bounds=[-0.1, 1.0])
+    n = solver.dims.N
+    r = solver.step([0, 0, 0, 1.0], [5, 0, 0, 0.8], [[0.3, 0.0]], np.tile([[0.3, 0.0]], (n + 1, 1, 1)))
+    assert r.stop and r.reason == "human_too_close"
+    assert r.u0[0] == -0.1 and r.command[0] == pytest.approx(1.0 - 0.1 * 0.1) and r.command[1] == 0.0

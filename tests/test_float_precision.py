@@ -154,14 +154,18 @@ def test_float_host_makes_the_doubles_stop_decisions_on_warm_replays(float_root:
     dbl = humanmpc.load(make_solver(float_root, {"preset": "paper", "name": "lsd", "solver": ls}))
     flt = humanmpc.load(make_solver(float_root, {"preset": "paper", "name": "lsf", "precision": "float", "solver": ls}))
     unsafe_plan = 7
+    stops = 0
     for nh_seed in (0, 1, 2):
         replay = fw.record_replay(dbl, steps=60, seed=nh_seed)
         a, b = fw.host_results(dbl, replay), fw.host_results(flt, replay)
         differ = [(i, ra.stop_reason, rb.stop_reason) for i, (ra, rb) in enumerate(zip(a, b, strict=True))
                   if (ra.stop, ra.stop_reason) != (rb.stop, rb.stop_reason)]
         assert len(differ) <= 1 and all({da, db} == {0, unsafe_plan} for _, da, db in differ), differ
-        assert sum(r.stop for r in a) >= 1
+        stops += sum(r.stop for r in a)
         assert not any(r.stop_reason == 4 for r in b), "a float QP failed"
+    # decisions to agree on: since the damped RTI starts within the bounds (issue 22, item 10) seed 2's
+    # loop passes without a stop; 24 over the three
+    assert stops >= 3
 
 
 def test_float_needs_the_qp_tolerance_the_spec_demands(pair: tuple[humanmpc.Solver, humanmpc.Solver],

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..codegen.cli import positive_int
+from ..codegen.cli import output_dir, positive_int
 from ..codegen.spec import SpecError, load_spec
 from .report import add_compare_arguments
 
@@ -49,7 +49,7 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--humans", default="5,10,20,30", help="crowd sizes N_h (default: 5,10,20,30)")
     p.add_argument("--seeds", type=positive_int, default=3, help="closed loops per crowd size (default: 3)")
     p.add_argument("--steps", type=positive_int, default=300, help="RTI steps per closed loop (default: 300)")
-    p.add_argument("--out", type=Path, default=Path("out/bench"), help="output folder (default: out/bench)")
+    p.add_argument("--out", type=output_dir, default=Path("out/bench"), help="output folder (default: out/bench)")
     p.add_argument("--controller", type=positive_int, metavar="TRACKS", nargs="?", const=30,
                    help="time the whole controller step (predictions, selection, OCP, monitors) with TRACKS "
                    "tracked people (default 30) instead of the RTI alone")

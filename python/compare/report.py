@@ -52,7 +52,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..bindings import load
-from ..codegen.cli import non_negative_int
+from ..codegen.cli import non_negative_int, output_dir
 from ..codegen.reference_nlp import ReferenceNlp
 from ..codegen.spec import Spec, load_spec, resolve_spec
 from .bench import cpu_name
@@ -430,7 +430,7 @@ def add_compare_arguments(parser: argparse.ArgumentParser) -> None:
                    help="recorded replays, one per spec (default: synthetic random crowds)")
     g.add_argument("--compare-steps", type=int, default=100, help="steps of each synthetic replay (default 100)")
     g.add_argument("--compare-seed", type=non_negative_int, default=0, help="seed of the synthetic replays (default 0)")
-    g.add_argument("--compare-out", type=Path, default=Path("out/compare"),
+    g.add_argument("--compare-out", type=output_dir, default=Path("out/compare"),
                    help="output folder (default out/compare)")
     g.add_argument("--compare-skip", nargs="+", default=[], choices=list(SOLVERS), metavar="SOLVER",
                    help=f"solvers to leave out: {', '.join(repr(s) for s in SOLVERS)}")

@@ -28,7 +28,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from ..codegen.cli import non_negative_int, positive_int
+from ..codegen.cli import non_negative_int, output_dir, positive_int
 from ..codegen.spec import Spec, load_spec
 from ..planners.registry import planner_names
 from ..planners.solver_dir import CACHE_DIR, SolverDirError, check_solver_dir, select_solver
@@ -172,7 +172,8 @@ def add_evaluate_parser(subparsers: argparse._SubParsersAction) -> argparse.Argu
                    help=f"number of seeds per scenario (default 10); {_RECORDED_SEEDS}")
     p.add_argument("--first-seed", type=non_negative_int, default=0, help="first seed (default 0)")
     p.add_argument("--workers", type=positive_int, default=2, help="parallel worker processes (default 2)")
-    p.add_argument("--out", type=Path, default=Path("out/evaluation"), help="output folder (default out/evaluation)")
+    p.add_argument("--out", type=output_dir, default=Path("out/evaluation"),
+                   help="output folder (default out/evaluation)")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_solver_options(p)
@@ -208,7 +209,7 @@ def add_demo_parser(subparsers: argparse._SubParsersAction) -> argparse.Argument
     p.add_argument("--scenario", default="crossing_group",
                    help=f"the scenario (default crossing_group); one of: {', '.join(sorted(SCENARIOS))}")
     p.add_argument("--seed", type=non_negative_int, default=0, help=f"scenario seed (default 0); {_RECORDED_SEEDS}")
-    p.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
+    p.add_argument("--out", type=output_dir, default=Path("out/demo"), help="output folder (default out/demo)")
     add_solver_options(p)
     p.set_defaults(func=_demo)
     return p

@@ -9,7 +9,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-from ..codegen.cli import non_negative_int
+from ..codegen.cli import non_negative_int, output_dir, positive_int
 from ..codegen.spec import SpecError, load_spec
 from ..status import OUTCOME_NAMES, STOP_REASONS
 from .controller import DEADLINE_PROBE_MS, ControllerAgreement, ControllerRun, run_controller_firmware
@@ -124,9 +124,9 @@ def add_firmware_parser(subparsers: Any) -> None:
                    help="cortex-m4 (mps2-an386, single-precision FPU) or cortex-m7 (mps2-an500); default cortex-m7")
     p.add_argument("--replay", type=Path, help="a replay .npz (humanmpc.compare.replay format) instead of a "
                    "recorded loop")
-    p.add_argument("--steps", type=int, default=60, help="steps of the recorded loop (default 60)")
+    p.add_argument("--steps", type=positive_int, default=60, help="steps of the recorded loop (default 60)")
     p.add_argument("--seed", type=non_negative_int, default=0, help="seed of the recorded crowd (default 0)")
-    p.add_argument("--humans", type=int, help="humans in the recorded crowd (default: the solver's N_h)")
+    p.add_argument("--humans", type=non_negative_int, help="humans in the recorded crowd (default: the solver's N_h)")
     p.add_argument("--cold", action="store_true",
                    help="reset the solver (and the controller) before every step (each step then depends on its own "
                    "inputs only)")
@@ -147,5 +147,5 @@ def add_firmware_parser(subparsers: Any) -> None:
     p.add_argument("--precisions", default="double,float", help="precisions (default double,float)")
     p.add_argument("--steps", type=int, default=20, help="replay steps per run (default 20)")
     p.add_argument("--seed", type=non_negative_int, default=0, help="seed of the recorded crowds (default 0)")
-    p.add_argument("--out", type=Path, default=Path("out/firmware"), help="output folder (default out/firmware)")
+    p.add_argument("--out", type=output_dir, default=Path("out/firmware"), help="output folder (default out/firmware)")
     p.set_defaults(func=_cmd_report)

@@ -31,14 +31,7 @@
 #define NH_ALLOC ((int)(sizeof(((S(input) *)0)->humans_now) / sizeof(((S(input) *)0)->humans_now[0])))
 #define NNODES ((int)(sizeof(((S(output) *)0)->x) / sizeof(((S(output) *)0)->x[0])))
 #define DT 0.1
-/* the stop reasons are the runtime's table (hm_status.h): as many as have a message */
-#define MAX_REASONS 32
-static int count_reasons(void)
-{
-    int j = 1;
-    while (j < MAX_REASONS && strcmp(S(stop_reason_message)(j), "unknown stop reason") != 0) j++;
-    return j;
-}
+#define MAX_REASONS 32 /* the table has n_reasons rows (counted at start, by their messages) */
 
 #ifdef OCP_QP_IPM_PROFILE
 #include <time.h>
@@ -101,7 +94,7 @@ int main(int argc, char **argv)
     const long steps = argc > 1 ? atol(argv[1]) : 1000;
     const double deadline_ms = argc > 3 ? atof(argv[3]) : 20.0;
     long t, counts[MAX_REASONS] = {0}, violations = 0, injected = 0;
-    const int n_reasons = count_reasons();
+    int n_reasons = 0;
     double x[4] = {0.0, 0.0, 0.0, 0.0}, goal[2][2] = {{12.0, 0.0}, {0.0, 0.0}}, worst_ms = 0.0;
     double closest = 1e9;
     const int fixed = argc > 4 && strcmp(argv[4], "fixed") == 0;
@@ -111,6 +104,7 @@ int main(int argc, char **argv)
     double total_ms = 0.0, prepare_ms = 0.0;
     rng_state = (unsigned long long)(argc > 2 ? atol(argv[2]) : 1) * 2654435761ULL + 1ULL;
     if (NH_ALLOC > 64) return 100;
+    while (n_reasons < MAX_REASONS && strcmp(S(stop_reason_message)(n_reasons), "unknown stop reason") != 0) n_reasons++;
     S(solver_init)(&solver);
     S(solver_params)(&solver)->deadline_ms = deadline_ms;
     for (j = 0; j < NH_ALLOC; j++) spawn(j, x);
