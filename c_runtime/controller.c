@@ -338,7 +338,13 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
     }
     /* A speed to track that the robot may not use towards its goal rewards the plan for spending it
      * elsewhere: with people between it and the goal, it circled at cruising speed. */
-    in->goal[3] = hm_fmin(in->goal[3], controller_separation_towards(cin, in->x0, in->goal, in->goal[3], &c->params));
+    {
+        const hm_real dx = in->goal[0] - in->x0[0], dy = in->goal[1] - in->x0[1];
+        const hm_real len = hm_sqrt(dx * dx + dy * dy);
+        if (len > HM_R(1e-9))
+            in->goal[3] = hm_fmin(in->goal[3], controller_separation_bound(cin, in->x0, dx / len, dy / len, in->goal[3],
+                                                                           &c->params));
+    }
     controller_expected_path(s, cin, path);
     controller_select_people(path, cin, in, out);
     controller_nearest_obstacle(path, cin, c->solver.params.v_bounds[1], in);
@@ -357,8 +363,13 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
         out->recovered = controller_recover(c, t0, 1, out);
     }
     /* the OCP sees N_h people; the command must keep its distance from every track */
-    if (!c->out.stop && !controller_check_separation(cin, in->x0, c->out.command[0], &c->params))
-        ocp_nlp_protective_stop(s, in, &c->out, HM_STOP_SEPARATION);
+    if (!c->out.stop) {
+        const hm_real v = c->out.command[0];
+        const hm_real bound = controller_separation_bound(cin, in->x0, hm_cos(in->x0[2]), hm_sin(in->x0[2]), v,
+                                                          &c->params);
+        if (monitor_separation_exceeded(v, bound, &c->params))
+            ocp_nlp_protective_stop(s, in, &c->out, HM_STOP_SEPARATION);
+    }
     controller_report(c, out);
     if (out->stalled && !out->stop) out->outcome = HM_OUTCOME_STALLED;
     out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);

@@ -109,34 +109,16 @@ HM_FUNC void controller_nearest_obstacle(hm_real path[HM_N + 1][2], const hm_con
     }
 }
 
-HM_FUNC int controller_check_separation(const hm_controller_input *cin, const hm_real *x0, hm_real v,
-                                        const hm_params *params)
+HM_FUNC hm_real controller_separation_bound(const hm_controller_input *cin, const hm_real *x0, hm_real cos_t,
+                                            hm_real sin_t, hm_real v_cap, const hm_params *params)
 {
-    const hm_real cos_t = hm_cos(x0[2]), sin_t = hm_sin(x0[2]);
-    const hm_real tol = HM_R(1e-6) + params->qp_tol; /* as the solver's own check */
-    int i;
-    if (!params->separation || !(v > tol)) return 1;
-    for (i = 0; i < cin->n_tracks; i++) {
-        const hm_real *t = cin->tracks[i];
-        if (v > monitor_separation_speed(x0, cos_t, sin_t, t, t + 2, params->d_h, params->reaction_time,
-                                         -params->a_bounds[0], v) + tol)
-            return 0;
-    }
-    return 1;
-}
-
-HM_FUNC hm_real controller_separation_towards(const hm_controller_input *cin, const hm_real *x0, const hm_real *to,
-                                              hm_real v_cap, const hm_params *params)
-{
-    const hm_real dx = to[0] - x0[0], dy = to[1] - x0[1];
-    const hm_real len = hm_sqrt(dx * dx + dy * dy);
     hm_real bound = HM_INF;
     int i;
-    if (!params->separation || !(len > HM_R(1e-9))) return HM_INF;
+    if (!params->separation) return HM_INF;
     for (i = 0; i < cin->n_tracks; i++) {
         const hm_real *t = cin->tracks[i];
-        bound = hm_fmin(bound, monitor_separation_speed(x0, dx / len, dy / len, t, t + 2, params->d_h,
-                                                        params->reaction_time, -params->a_bounds[0], v_cap));
+        bound = hm_fmin(bound, monitor_separation_speed(x0, cos_t, sin_t, t, t + 2, params->d_h, params->reaction_time,
+                                                        -params->a_bounds[0], v_cap));
     }
     return bound;
 }

@@ -27,15 +27,10 @@ HM_FUNC void controller_select_people(hm_real path[HM_N + 1][2], const hm_contro
 HM_FUNC void controller_nearest_obstacle(hm_real path[HM_N + 1][2], const hm_controller_input *cin, hm_real speed,
                                          hm_input *in);
 
-/* 1 when the command speed v from the state x0 keeps speed and separation (monitor_separation_speed)
- * from every track, not only the N_h the OCP sees; always 1 without params->separation. */
-HM_FUNC int controller_check_separation(const hm_controller_input *cin, const hm_real *x0, hm_real v,
-                                        const hm_params *params);
-
-/* The speed-and-separation bound of every track for a robot at x0 heading straight for the point
- * `to` (HM_INF when none binds below v_cap, or without params->separation): the speed the OCP can use
- * towards its goal. */
-HM_FUNC hm_real controller_separation_towards(const hm_controller_input *cin, const hm_real *x0, const hm_real *to,
-                                              hm_real v_cap, const hm_params *params);
+/* The smallest monitor_separation_speed over every track (not only the N_h the OCP sees), for a robot
+ * at x0 heading along (cos_t, sin_t): HM_INF when none binds below v_cap, or without
+ * params->separation. */
+HM_FUNC hm_real controller_separation_bound(const hm_controller_input *cin, const hm_real *x0, hm_real cos_t,
+                                            hm_real sin_t, hm_real v_cap, const hm_params *params);
 
 #endif /* CONTROLLER_PEOPLE_H */

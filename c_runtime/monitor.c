@@ -101,21 +101,32 @@ HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_rea
     return HM_R(-2.0) * gamma / (beta + hm_sqrt(beta * beta - HM_R(4.0) * alpha * gamma));
 }
 
+HM_FUNC hm_real monitor_separation_bound(const hm_input *in, const hm_params *p, const hm_real *x, int n,
+                                         hm_real v_cap)
+{
+    const int k = n < HM_N ? n : HM_N - 1;
+    const hm_real cos_t = hm_cos(x[2]), sin_t = hm_sin(x[2]);
+    hm_real bound = HM_INF;
+    int j;
+    for (j = 0; j < ocp_nlp_clamp_humans(in); j++) {
+        const hm_real vh[2] = {(in->humans_pred[k + 1][j][0] - in->humans_pred[k][j][0]) / HM_R(HM_DT),
+                               (in->humans_pred[k + 1][j][1] - in->humans_pred[k][j][1]) / HM_R(HM_DT)};
+        const hm_real *h = n == 0 ? in->humans_now[j] : in->humans_pred[n][j];
+        bound = hm_fmin(bound, monitor_separation_speed(x, cos_t, sin_t, h, vh, p->d_h, p->reaction_time,
+                                                        -p->a_bounds[0], v_cap));
+    }
+    return bound;
+}
+
+HM_FUNC int monitor_separation_exceeded(hm_real v, hm_real bound, const hm_params *p)
+{
+    const hm_real tol = HM_R(1e-6) + p->qp_tol;
+    return v > tol && v > bound + tol;
+}
+
 HM_FUNC int monitor_check_separation(const hm_input *in, const hm_params *p, hm_real v)
 {
-    const hm_real cos_t = hm_cos(in->x0[2]), sin_t = hm_sin(in->x0[2]);
-    /* the QP keeps the same bound to its tolerance; beyond that, braking could not keep it */
-    const hm_real tol = HM_R(1e-6) + p->qp_tol;
-    int j;
-    if (!p->separation || !(v > tol)) return 1;
-    for (j = 0; j < ocp_nlp_clamp_humans(in); j++) {
-        const hm_real vh[2] = {(in->humans_pred[1][j][0] - in->humans_pred[0][j][0]) / HM_R(HM_DT),
-                               (in->humans_pred[1][j][1] - in->humans_pred[0][j][1]) / HM_R(HM_DT)};
-        if (v > monitor_separation_speed(in->x0, cos_t, sin_t, in->humans_now[j], vh, p->d_h, p->reaction_time,
-                                         -p->a_bounds[0], v) + tol)
-            return 0;
-    }
-    return 1;
+    return !p->separation || !monitor_separation_exceeded(v, monitor_separation_bound(in, p, in->x0, 0, v), p);
 }
 
 HM_FUNC const char *monitor_stop_reason_message(int reason)

@@ -61,8 +61,19 @@ HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_rea
                                          const hm_real *vh, hm_real d_h, hm_real t_r, hm_real a_brake,
                                          hm_real v_cap);
 
-/* 1 when the command v keeps speed and separation (above) from every present human of in, whose
- * velocities are those of their predictions over the first interval; x0's heading is the robot's. */
+/* The smallest monitor_separation_speed over the present humans of in, for a robot at x (heading x[2]):
+ * each human at node n's prediction (their current position at n = 0), closing at the velocity of
+ * their prediction over the interval from node n (the last interval's at n = N). HM_INF when none
+ * binds below v_cap. The OCP's bounds (ocp_nlp_lin.c) and the command's check below. */
+HM_FUNC hm_real monitor_separation_bound(const hm_input *in, const hm_params *p, const hm_real *x, int n,
+                                         hm_real v_cap);
+
+/* 1 when the commanded speed v is above the speed-and-separation bound by more than the QP's
+ * tolerance (which keeps the same bound to it): braking could not keep the separation. */
+HM_FUNC int monitor_separation_exceeded(hm_real v, hm_real bound, const hm_params *p);
+
+/* 1 when the command v keeps speed and separation (above) from every present human of in, from the
+ * measured state x0; always 1 without params.separation. */
 HM_FUNC int monitor_check_separation(const hm_input *in, const hm_params *p, hm_real v);
 HM_FUNC const char *monitor_stop_reason_message(int reason);
 

@@ -191,28 +191,6 @@ static void ocp_nlp_convexify_stage(hm_ocp_qp *qp, int n, hm_real floor)
     }
 }
 
-/* The speed-and-separation bound of node n + 1 from node n's geometry (the robot at x, every present
- * human at their predicted position there, closing at their predicted velocity over the interval
- * that starts there): the smallest monitor_separation_speed, HM_INF when none binds below v_cap. */
-static hm_real ocp_nlp_separation_bound(const hm_solver *s, const hm_input *in, const hm_real *x, int n)
-{
-    const hm_params *p = &s->params;
-    const int nh = ocp_nlp_clamp_humans(in);
-    const int k = n < HM_N ? n : HM_N - 1; /* the last node keeps the last interval's velocity */
-    const hm_real cos_t = hm_cos(x[2]), sin_t = hm_sin(x[2]);
-    const hm_real v_cap = p->v_bounds[1];
-    hm_real bound = HM_INF;
-    int j;
-    for (j = 0; j < nh; j++) {
-        const hm_real vh[2] = {(in->humans_pred[k + 1][j][0] - in->humans_pred[k][j][0]) / HM_R(HM_DT),
-                               (in->humans_pred[k + 1][j][1] - in->humans_pred[k][j][1]) / HM_R(HM_DT)};
-        const hm_real *h = n == 0 ? in->humans_now[j] : in->humans_pred[n][j];
-        bound = hm_fmin(bound, monitor_separation_speed(x, cos_t, sin_t, h, vh, p->d_h, p->reaction_time,
-                                                        -p->a_bounds[0], v_cap));
-    }
-    return bound;
-}
-
 /* Build the QP of the current iterate (everything but the initial-state offset) and the NLP
  * objective there. Rows: the present humans first, then the obstacle; absent ones cost nothing.
  * exact = 0: Gauss-Newton Hessian (PSD by construction). exact = 1: the Hessian of the Lagrangian
@@ -296,7 +274,8 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
         qp->lbx[n][3] = p->v_bounds[0] - x[3];
         qp->ubx[n][3] = p->v_bounds[1] - x[3];
         /* node 1's bound comes from the measured state (ocp_nlp_set_x0) */
-        if (p->separation && n >= 2) s->v_separation[n] = ocp_nlp_separation_bound(s, in, s->x[n - 1], n - 1);
+        if (p->separation && n >= 2)
+            s->v_separation[n] = monitor_separation_bound(in, p, s->x[n - 1], n - 1, p->v_bounds[1]);
         qp->ng[n] = ng;
         for (j = 0; j < ng; j++) {
             const int human = j < nh;
@@ -341,7 +320,7 @@ HM_FUNC void ocp_nlp_set_x0(hm_solver *s, const hm_input *in)
     int i, n;
     for (i = 0; i < HM_NX; i++) s->qp.x0[i] = in->x0[i] - s->x[0][i];
     if (!p->separation) return;
-    s->v_separation[1] = ocp_nlp_separation_bound(s, in, in->x0, 0);
+    s->v_separation[1] = monitor_separation_bound(in, p, in->x0, 0, p->v_bounds[1]);
     for (n = 1; n <= HM_N; n++) {
         const hm_real braked = hm_fmax(p->v_bounds[0], in->x0[3] + p->a_bounds[0] * HM_R(HM_DT) * (hm_real)n);
         s->v_separation[n] = hm_fmin(p->v_bounds[1], hm_fmax(s->v_separation[n], braked)); /* idempotent */
