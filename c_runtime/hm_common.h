@@ -12,6 +12,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "hm_math.h"
 #include "hm_status.h"
 
 /* The robot model is fixed by the product: unicycle state [px, py, theta, v], control [a, omega].
@@ -45,17 +46,18 @@
 
 /* Single precision is selected with HM_REAL_IS_FLOAT; all literals go through HM_R so that a float
  * build never promotes to double (an explicit cast of a constant is folded at compile time), and
- * all math goes through these wrappers. */
+ * all math goes through these wrappers: sin, cos, exp and atan2 to the runtime's own (hm_math.h), whose
+ * bits do not depend on the C library, the exactly rounded rest to <math.h>. */
 #ifdef HM_REAL_IS_FLOAT
 #define HM_R(x) ((float)(x))
 #define hm_sqrt sqrtf
 #define hm_fabs fabsf
-#define hm_exp expf
+#define hm_exp hm_math_expf
 #define hm_fmax fmaxf
 #define hm_fmin fminf
-#define hm_atan2 atan2f
-#define hm_cos cosf
-#define hm_sin sinf
+#define hm_atan2 hm_math_atan2f
+#define hm_cos hm_math_cosf
+#define hm_sin hm_math_sinf
 #define hm_floor floorf
 #define HM_EPS 1.1920929e-07f
 #define HM_INF 1.0e30f
@@ -63,12 +65,12 @@
 #define HM_R(x) ((double)(x))
 #define hm_sqrt sqrt
 #define hm_fabs fabs
-#define hm_exp exp
+#define hm_exp hm_math_exp
 #define hm_fmax fmax
 #define hm_fmin fmin
-#define hm_atan2 atan2
-#define hm_cos cos
-#define hm_sin sin
+#define hm_atan2 hm_math_atan2
+#define hm_cos hm_math_cos
+#define hm_sin hm_math_sin
 #define hm_floor floor
 #define HM_EPS 2.220446049250313e-16
 #define HM_INF 1.0e30

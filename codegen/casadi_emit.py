@@ -40,6 +40,14 @@ _MATH_FUNCTIONS = (
     "ceil", "round", "trunc", "erf", "erfc", "copysign", "hypot",
 )
 _MATH_CALL = re.compile(r"(?<![\w.])(" + "|".join(_MATH_FUNCTIONS) + r")(?=\s*\()")
+# Functions whose result C99 leaves to the library (one bit differs between glibc and newlib): the
+# model calls the runtime's own (c_runtime/hm_math.h), so that a robot's computer and its firmware
+# compute the same bits. The others the model may call are exactly rounded by IEEE 754 (sqrt) or
+# exact (fabs, fmin, ...), the same everywhere.
+_PORTABLE_FUNCTIONS = ("sin", "cos", "exp", "atan2")
+_EXACT_FUNCTIONS = ("sqrt", "fabs", "fmin", "fmax", "floor", "ceil", "round", "trunc", "copysign", "fmod")
+_LIBRARY_CALL = re.compile(r"(?<![\w.])(" + "|".join(_MATH_FUNCTIONS) + r")(f?)(?=\s*\()")
+_MATH_INCLUDE = "#include <math.h>\n"
 # A decimal floating literal without suffix: 2., 0.5, .5, 1e-6, 1.0000000000000001e-01.
 _DOUBLE_LITERAL = re.compile(
     r"(?<![\w.])((?:[0-9]+\.[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?|[0-9]+[eE][-+]?[0-9]+)(?![\w.])"
@@ -84,6 +92,33 @@ def make_single_precision(source: str) -> str:
     return _DOUBLE_LITERAL.sub(r"\1f", _MATH_CALL.sub(r"\1f", source))
 
 
+class ModelMathError(ValueError):
+    """The model's C calls a <math.h> function the runtime has no portable version of."""
+
+
+def use_portable_math(source: str) -> str:
+    """sin/cos/exp/atan2 (and their f-variants) to the runtime's hm_math_*, included from the
+    package's runtime/ folder; any other library function whose last bit is the library's is an error
+    (the generated package would compute differently on different C libraries)."""
+
+    def rename(m: re.Match[str]) -> str:
+        name, suffix = m.group(1), m.group(2)
+        if name in _PORTABLE_FUNCTIONS:
+            return f"hm_math_{name}{suffix}"
+        if name in _EXACT_FUNCTIONS:
+            return m.group(0)
+        raise ModelMathError(
+            f"the model functions call {name}{suffix}(), whose result depends on the C library; "
+            f"c_runtime/hm_math.h provides {', '.join(_PORTABLE_FUNCTIONS)}: add {name} there "
+            "(and to codegen/casadi_emit.py's _PORTABLE_FUNCTIONS) or write the model without it"
+        )
+
+    if _MATH_INCLUDE not in source:
+        raise ModelMathError("CasADi's C no longer includes <math.h> where humanmpc expects it")
+    renamed = _LIBRARY_CALL.sub(rename, source)
+    return renamed.replace(_MATH_INCLUDE, _MATH_INCLUDE + '#include "runtime/hm_math.h"\n', 1)
+
+
 def emit_model(functions: tuple[ModelFunction, ...], prefix: str, real: str, out_dir: Path) -> list[EmittedFunction]:
     """Write {prefix}_model.c/.h into out_dir; return what the templates need of each function."""
     basename = f"{prefix}_model"
@@ -123,11 +158,11 @@ def emit_model(functions: tuple[ModelFunction, ...], prefix: str, real: str, out
     banner = (
         f"/* {basename}.c: model functions of the humanmpc solver \"{prefix}\", written by CasADi "
         f"{ca.CasadiMeta.version()}\n * and adjusted mechanically by humanmpc (static helpers,{single} parameters "
-        "marked used). Do not edit. */\n"
+        "marked used, sin/cos/exp of runtime/hm_math.h). Do not edit. */\n"
     )
     c_file = out_dir / f"{basename}.c"
     text = make_helpers_static(make_parameters_used(c_file.read_text()))
     if real == "float":
         text = make_single_precision(text)
-    c_file.write_text(banner + text)
+    c_file.write_text(banner + use_portable_math(text))
     return emitted

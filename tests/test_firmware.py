@@ -6,20 +6,15 @@ semihosting for the console, SysTick under -icount for instruction counts.
 
 What is compared, and why so:
 
-* cold replays (the solver reset before every step) make each step depend on its own inputs only:
-  there the Cortex-M7 double build must reproduce the x86-64 host to 1e-9 (in practice the two
-  agree bit for bit on most steps; the differences come from newlib's sin/cos/exp against glibc's,
-  which differ in the last bit for some arguments).
-* warm replays (the warm start kept, as in use) feed those last-bit differences back through the
-  real-time iteration. With the paper's zero control weights the full-step RTI amplifies a 1e-15
-  perturbation of x0 to 1e-2 in u0 within 40 steps on the host alone, so no two builds agree
-  to 1e-9 over a long warm replay; what must agree there are the decisions (status, protective
-  stop and its reason, QP status) at every step.
-* single precision: the float builds are compared with FLOAT_U0_TOL (see test_float_precision.py).
-* the navigation controller (<name>_controller_step, humanmpc.firmware.controller) is replayed on a
-  recorded closed loop of the host controller: M7 double against the host to CTL_M7_TOL, M4F float
-  against the float host within the CTL_FLOAT_* tolerances (justified where they are defined, with
-  the numbers in docs/firmware.md).
+* the same bits. The arithmetic is IEEE 754 on both sides, without contraction (-std=c99), and the
+  functions whose last bit C leaves to the library (sin, cos, exp, atan2: newlib's differ from
+  glibc's) are the runtime's own (c_runtime/hm_math.h, tests/test_portable_math.py). So the
+  Cortex-M7 double build reproduces the x86-64 double host, and the Cortex-M4F float build the
+  float host, bit for bit: every step of the solver's replays and every period of the controller's,
+  warm (as in use) and cold (reset before each). Before hm_math.h the two drifted apart by up to
+  3.7e-8 (M7) and whole decisions (M4F) within a warm replay (docs/firmware.md).
+* single precision against double: the float builds are compared with FLOAT_U0_TOL (see
+  test_float_precision.py).
 """
 
 from __future__ import annotations
@@ -142,25 +137,21 @@ def test_replay_holds_solved_steps_and_protective_stops(double_dir: Path, replay
 # -- Cortex-M7, double precision ----------------------------------------------------------------
 
 
-def test_m7_double_reproduces_the_host_to_1e9_on_a_cold_replay(m7_double: dict[str, FwResult]) -> None:
-    r = m7_double["cold"]
-    assert len(r.run.steps) == STEPS >= 50
-    assert _decisions(r.run.steps) == _decisions(r.host)
-    assert [s.qp_iterations for s in r.run.steps] == [h.qp_iterations for h in r.host]
-    for s, h in zip(r.run.steps, r.host, strict=True):
-        assert np.max(np.abs(np.asarray(s.u0) - h.u0)) <= 1e-9, f"step {s.t}: u0 {s.u0} vs host {h.u0}"
-        assert np.max(np.abs(np.asarray(s.command) - h.command)) <= 1e-9
-        assert np.max(np.abs(np.asarray(s.x_end) - h.x[-1, :2])) <= 1e-9, f"step {s.t}: plan end differs"
-        assert abs(s.cost - h.cost) <= 1e-9 * max(1.0, abs(h.cost))
-        if np.isfinite(h.min_human_distance):
-            assert abs(s.min_human_distance - h.min_human_distance) <= 1e-9
+def _assert_bit_equal_steps(run: fw.FirmwareRun, host: list, what: str) -> None:
+    assert _decisions(run.steps) == _decisions(host), what
+    assert [st.qp_iterations for st in run.steps] == [h.qp_iterations for h in host], what
+    for st, h in zip(run.steps, host, strict=True):
+        assert tuple(st.u0) == tuple(h.u0), f"{what}, step {st.t}: u0 {st.u0} vs host {h.u0}"
+        assert tuple(st.command) == tuple(h.command), f"{what}, step {st.t}"
+        assert tuple(st.x_end) == tuple(h.x[-1, :2]), f"{what}, step {st.t}: plan end differs"
+        assert st.cost == h.cost or (np.isnan(st.cost) and np.isnan(h.cost)), f"{what}, step {st.t}"
 
 
-def test_m7_double_makes_the_hosts_decisions_on_a_warm_replay(m7_double: dict[str, FwResult]) -> None:
-    r = m7_double["warm"]
-    assert len(r.run.steps) == STEPS
-    assert _decisions(r.run.steps) == _decisions(r.host)
-    assert all(np.all(np.isfinite(s.u0)) for s in r.run.steps)
+def test_m7_double_reproduces_the_host_bit_for_bit_warm_and_cold(m7_double: dict[str, FwResult]) -> None:
+    for mode in ("cold", "warm"):
+        r = m7_double[mode]
+        assert len(r.run.steps) == STEPS >= 50
+        _assert_bit_equal_steps(r.run, r.host, f"M7 double {mode}")
 
 
 def test_instruction_counts_are_calibrated_and_repeatable(m7_double: dict[str, FwResult]) -> None:
@@ -175,11 +166,11 @@ def test_instruction_counts_are_calibrated_and_repeatable(m7_double: dict[str, F
 # -- Cortex-M4F, single precision ---------------------------------------------------------------
 
 
-def test_m4_float_makes_the_float_hosts_decisions(m4_float: dict[str, FwResult]) -> None:
+def test_m4_float_reproduces_the_float_host_bit_for_bit_warm_and_cold(m4_float: dict[str, FwResult]) -> None:
     for mode in ("cold", "warm"):
         r = m4_float[mode]
         assert r.run.real == "float" and len(r.run.steps) == STEPS
-        assert _stops(r.run.steps) == _stops(r.host), mode
+        _assert_bit_equal_steps(r.run, r.host, f"M4F float {mode}")
 
 
 def test_m4_float_stays_within_the_float_tolerance_of_both_hosts(m4_float: dict[str, FwResult]) -> None:
@@ -198,13 +189,16 @@ def test_float_image_links_no_heap_and_no_double_precision(m4_float: dict[str, F
         found = fw.forbidden_symbols(elf, "float")
         assert found == {"heap": [], "double_math": [], "soft_double": []}, f"{elf.name}: {found}"
         syms = fw.linked_symbols(elf)
-        assert {"sinf", "cosf", "expf"} <= syms  # the single-precision math is there: the check is not vacuous
+        # the single-precision math is there (hm_math.h's exp scales by ldexpf): the check is not vacuous
+        assert "ldexpf" in syms and not {"sinf", "cosf", "expf"} & syms
         assert "fwf_solver_step" in syms
 
 
 def test_double_image_links_no_heap(m7_double: dict[str, FwResult]) -> None:
     assert fw.forbidden_symbols(m7_double["cold"].elf, "double") == {"heap": []}
-    assert {"sin", "cos", "exp"} <= fw.linked_symbols(m7_double["cold"].elf)
+    syms = fw.linked_symbols(m7_double["cold"].elf)
+    # sin/cos/exp are the runtime's (hm_math.h), not newlib's, whose last bit differs from glibc's
+    assert "ldexp" in syms and not {"sin", "cos", "exp"} & syms
 
 
 # -- footprint ----------------------------------------------------------------------------------
@@ -248,30 +242,6 @@ CTL_SEED = 0
 # the weight the scene ends before the goal and the stops, with the separation it has no C2 stop.
 CTL_SPEC = {"humans": {"max": 5, "separation": False}, "weights": {"control": [0.0, 0.0]},
             "controller": {"max_tracks": 8, "max_path_points": 32, "max_obstacle_points": 32}}
-# Cortex-M7 double against the x86-64 host, per period of the replay. The arithmetic is the same
-# (IEEE, no contraction on either side); the math libraries are not: newlib's sin/cos/exp differ from
-# glibc's in the last bit for some arguments, and the RTI's warm start and the recovery SQP amplify
-# that. The typical period agrees to 1e-12 (median; measured 5e-16), every period to the QP tolerance
-# qp_tol (the solver does not determine u more finely than it solves its QPs; measured 4.9e-12 here,
-# up to 3.7e-8 over 8 scenes, and the host against itself with glibc's FMA variants of sin/cos/exp
-# switched off: up to 2.5e-7), with the host's decisions and choice of people in every period.
-CTL_M7_MEDIAN_TOL = 1e-12
-# Cortex-M4F float against the float host library (relative: divided by the width of the bounds of
-# each component, v, omega, a). Cold periods (the controller reset before each) are compared period by
-# period: where both take the same decisions, within 2.5 % of the bounds (the solver's FLOAT_U0_TOL,
-# 0.05 on a range of 2; measured at most 2.0 % over 8 scenes, 1.9e-4 here), the median period within
-# 1e-5 (measured <= 4e-8); decisions may differ in 2.5 % of the periods (measured 0-3 of 140 over 8
-# scenes, 0 here): plans at single precision's floor (a QP stops at its iteration limit or fails
-# numerically on one side: a protective stop there; a plan on the loop test's threshold: a recovery).
-# Warm replays (as in use) diverge after the first such period, the two controllers' warm starts then
-# differ: decisions may differ in 10 % of the periods (measured 1-8 of 140, 1 here), the median period
-# within 1e-5. The monitor's stops for a person within d_h depend on the inputs only: always the same.
-CTL_FLOAT_REL_TOL = 0.025
-CTL_FLOAT_MEDIAN_REL_TOL = 1e-5
-CTL_FLOAT_COLD_MISMATCHES = 0.025
-CTL_FLOAT_WARM_MISMATCHES = 0.10
-
-
 @dataclass
 class CtlResult:
     run: fc.ControllerRun
@@ -352,61 +322,33 @@ def test_controller_replay_data_is_packed_without_repeating_unchanged_rows(ctl_r
     assert offsets == [0, 0, 2, 3] and table.tolist() == [[1, 1], [2, 2], [3, 3], [3, 3], [4, 4]]
 
 
-def test_m7_double_controller_makes_the_hosts_decisions_and_choices_in_every_period(
-        ctl_m7: dict[str, CtlResult]) -> None:
-    for mode, r in ctl_m7.items():
-        assert r.run.real == "double" and len(r.run.steps) == CTL_STEPS, mode
-        assert r.agree.same_decisions, f"{mode}: {r.agree.first_mismatch}"
-        assert r.agree.people_mismatches == 0, mode
-        assert [s.qp_iterations for s in r.run.steps] == [h.qp_iterations for h in r.host], mode
-        assert [s.sqp_iterations for s in r.run.steps] == [h.sqp_iterations for h in r.host], mode
-
-
-def test_m7_double_controller_commands_equal_the_hosts_to_1e12_typically_and_to_qp_tol_always(
-        ctl_m7: dict[str, CtlResult]) -> None:
-    for mode, r in ctl_m7.items():
-        dc = np.array([np.max(np.abs(np.asarray(s.command) - h.command)) for s, h in zip(r.run.steps, r.host,
-                                                                                            strict=True)])
-        du = np.array([np.max(np.abs(np.asarray(s.u) - h.u)) for s, h in zip(r.run.steps, r.host, strict=True)])
-        dg = np.array([np.max(np.abs(np.asarray(s.ocp_goal) - h.ocp_goal)) for s, h in zip(r.run.steps, r.host,
-                                                                                             strict=True)])
-        assert np.median(dc) <= CTL_M7_MEDIAN_TOL and np.median(du) <= CTL_M7_MEDIAN_TOL, mode
-        tol = float(r.params["qp_tol"])
-        assert dc.max() <= tol and du.max() <= tol, f"{mode}: period {int(du.argmax())}: |u diff| {du.max():.3g}"
-        assert dg.max() <= 1e-9, f"{mode}: the carrot differs"  # geometry only: no solver in between
-        assert dc[0] == 0.0 and du[0] == 0.0, "the first period, from the same cold start, is bit-equal"
-
-
-def test_m7_float_controller_is_bit_equal_to_the_float_host_where_the_math_libraries_agree(
-        ctl_m7_float: CtlResult) -> None:
-    """The Cortex-M7 multilib links the same single-precision sinf/cosf/expf as glibc: with the math
-    library out of the way, every period of the warm replay is the host's, bit for bit, so what
-    separates the double builds above is the math library alone."""
-    r = ctl_m7_float
-    assert r.run.real == "float" and len(r.run.steps) == CTL_STEPS
-    assert r.agree.same_decisions and r.agree.people_mismatches == 0
-    assert r.agree.max_command_diff == 0.0 and r.agree.max_u_diff == 0.0
+def _assert_bit_equal_periods(r: CtlResult, what: str) -> None:
+    assert len(r.run.steps) == CTL_STEPS, what
+    assert r.agree.same_decisions, f"{what}: {r.agree.first_mismatch}"
+    assert r.agree.people_mismatches == 0, what
+    assert r.agree.max_command_diff == 0.0 and r.agree.max_u_diff == 0.0, what
     for s, h in zip(r.run.steps, r.host, strict=True):
-        assert s.plan_end == tuple(h.plan[-1, :2]) and s.ocp_goal == tuple(h.ocp_goal), f"period {s.t}"
+        assert (s.qp_iterations, s.sqp_iterations) == (h.qp_iterations, h.sqp_iterations), f"{what}, period {s.t}"
+        assert s.plan_end == tuple(h.plan[-1, :2]) and s.ocp_goal == tuple(h.ocp_goal), f"{what}, period {s.t}"
 
 
-def test_m4f_float_controller_stays_within_the_float_tolerance_period_by_period(ctl_m4f: dict[str, CtlResult]) -> None:
-    r = ctl_m4f["cold"]
-    assert r.run.real == "float" and len(r.run.steps) == CTL_STEPS
-    assert r.agree.outcome_mismatches <= CTL_FLOAT_COLD_MISMATCHES * CTL_STEPS, r.agree.first_mismatch
-    assert r.agree.max_rel_same <= CTL_FLOAT_REL_TOL
-    assert r.agree.median_rel <= CTL_FLOAT_MEDIAN_REL_TOL
-    assert _human_stops(r.run.steps) == _human_stops(r.host)
+def test_m7_double_controller_reproduces_the_host_bit_for_bit_in_every_period(ctl_m7: dict[str, CtlResult]) -> None:
+    for mode, r in ctl_m7.items():
+        assert r.run.real == "double", mode
+        _assert_bit_equal_periods(r, f"M7 double {mode}")
 
 
-def test_m4f_float_controller_takes_the_float_hosts_decisions_in_nearly_every_warm_period(
+def test_m4f_float_controller_reproduces_the_float_host_bit_for_bit_in_every_period(
         ctl_m4f: dict[str, CtlResult]) -> None:
-    r = ctl_m4f["warm"]
-    assert len(r.run.steps) == CTL_STEPS
-    assert r.agree.outcome_mismatches <= CTL_FLOAT_WARM_MISMATCHES * CTL_STEPS, r.agree.first_mismatch
-    assert r.agree.median_rel <= CTL_FLOAT_MEDIAN_REL_TOL
-    assert _human_stops(r.run.steps) == _human_stops(r.host)
-    assert all(np.all(np.isfinite(s.command)) and np.all(np.isfinite(s.u)) for s in r.run.steps)
+    for mode, r in ctl_m4f.items():
+        assert r.run.real == "float", mode
+        _assert_bit_equal_periods(r, f"M4F float {mode}")
+        assert _human_stops(r.run.steps) == _human_stops(r.host)
+
+
+def test_m7_float_controller_reproduces_the_float_host_bit_for_bit(ctl_m7_float: CtlResult) -> None:
+    assert ctl_m7_float.run.real == "float"
+    _assert_bit_equal_periods(ctl_m7_float, "M7 float warm")
 
 
 def test_controller_clock_hook_times_the_periods_and_its_deadline_stops_the_robot(
@@ -429,7 +371,8 @@ def test_controller_images_link_no_heap_and_the_float_image_no_double_precision(
     found = fw.forbidden_symbols(ctl_m4f["warm"].elf, "float")
     assert found == {"heap": [], "double_math": [], "soft_double": []}, found
     syms = fw.linked_symbols(ctl_m4f["warm"].elf)
-    assert {"fwcf_controller_step", "fwcf_controller_set_clock", "sinf", "cosf"} <= syms
+    assert {"fwcf_controller_step", "fwcf_controller_set_clock", "ldexpf"} <= syms
+    assert not {"sinf", "cosf", "expf"} & syms
 
 
 @pytest.fixture(scope="session")

@@ -1,0 +1,264 @@
+/*
+ * hm_math.h: sin, cos, exp and atan2 computed by the runtime itself, in double and in float.
+ *
+ * Why not <math.h>: C leaves these functions' last bit to the library, and libraries differ there
+ * (glibc's sin against newlib's on the firmware, even glibc's own FMA and non-FMA variants). The
+ * real-time iteration's warm start and the loop recovery amplify one bit into 1e-8 within a few
+ * hundred periods, so the same controller gave other commands on a robot's computer than on its
+ * Cortex-M. Built from +, -, *, / (IEEE, correctly rounded, not contracted under -std=c99) and the
+ * exact floor and ldexp/ldexpf, these give the same bits on every C99 platform with IEEE arithmetic
+ * and FLT_EVAL_METHOD 0 (x86-64 SSE, Arm VFP). Accuracy: within 3 ulp (double; 3.5 float) of the true value
+ * (tests/test_portable_math.py measures it against glibc). The argument reduction of sin and cos is
+ * exact for |x| < 8.2e5 rad (double) and 6.4e3 rad (float); beyond, an fmod by 2 pi makes them
+ * less accurate but still the same everywhere (the controller's angles stay far inside).
+ *
+ * Self-contained on purpose: the CasADi-generated model file includes it as well
+ * (codegen/casadi_emit.py renames its sin/cos/exp calls to these), so model and runtime share one
+ * set of functions. Polynomials are Taylor's, kept until the first term left out is below 1e-17
+ * (double) or 1e-9 (float) of the result; evaluated by Horner's rule from the highest term.
+ */
+#ifndef HM_MATH_H
+#define HM_MATH_H
+
+#include <math.h>
+
+#if defined(__GNUC__)
+#define HM_MATH_FUNC static __attribute__((unused))
+#else
+#define HM_MATH_FUNC static
+#endif
+
+/* ------------------------------------------------------------------------------------------------
+ * double
+ * ------------------------------------------------------------------------------------------------ */
+
+/* pi/2 in parts of 33, 33 and 53 bits: k * part is exact for |k| < 2^20. */
+#define HM_MATH_PIO2_1 1.5707963267341256
+#define HM_MATH_PIO2_2 6.077100506303966e-11
+#define HM_MATH_PIO2_3 2.0222662487959506e-21
+#define HM_MATH_2_PI 0.6366197723675814
+#define HM_MATH_REDUCE_MAX 823549.0 /* 2^19 pi/2 */
+#define HM_MATH_PI 3.141592653589793
+#define HM_MATH_PI_2 1.5707963267948966
+#define HM_MATH_PI_4 0.7853981633974483
+#define HM_MATH_TAN_PI_8 0.41421356237309503
+/* ln 2 in a 32-bit part and the rest: k * hi is exact for |k| < 2^21. */
+#define HM_MATH_LN2_HI 0.6931471806019545
+#define HM_MATH_LN2_LO (-4.2009150726810846e-11)
+#define HM_MATH_INV_LN2 1.4426950408889634
+
+/* c[0] + z (c[1] + z (c[2] + ...)), from the highest term. */
+HM_MATH_FUNC double hm_math_horner(const double *c, int n, double z) {
+    double p = c[n - 1];
+    int i;
+    for (i = n - 2; i >= 0; --i) p = p * z + c[i];
+    return p;
+}
+
+/* sin r = r + r z (-1/3! + z (1/5! - ...)), z = r^2, |r| <= pi/4: terms to r^19. */
+HM_MATH_FUNC double hm_math_sin_kernel(double r) {
+    static const double c[9] = {-0.16666666666666666,    0.008333333333333333,  -0.0001984126984126984,
+                                2.7557319223985893e-06,  -2.505210838544172e-08, 1.6059043836821613e-10,
+                                -7.647163731819816e-13,  2.8114572543455206e-15, -8.22063524662433e-18};
+    const double z = r * r;
+    return r + r * z * hm_math_horner(c, 9, z);
+}
+
+/* cos r = 1 - z (1/2! - z (1/4! - ...)): terms to r^18. */
+HM_MATH_FUNC double hm_math_cos_kernel(double r) {
+    static const double c[9] = {0.5,                    -0.041666666666666664, 0.001388888888888889,
+                                -2.48015873015873e-05,  2.755731922398589e-07, -2.08767569878681e-09,
+                                1.1470745597729725e-11, -4.779477332387385e-14, 1.5619206968586225e-16};
+    const double z = r * r;
+    return 1.0 - z * hm_math_horner(c, 9, z);
+}
+
+/* x = k pi/2 + r with |r| <= pi/4 (and rounding); the quadrant k mod 4 in 0..3. */
+HM_MATH_FUNC double hm_math_reduce(double x, int *quadrant) {
+    const double k = floor(x * HM_MATH_2_PI + 0.5);
+    *quadrant = (int)(k - 4.0 * floor(k * 0.25));
+    return ((x - k * HM_MATH_PIO2_1) - k * HM_MATH_PIO2_2) - k * HM_MATH_PIO2_3;
+}
+
+/* Beyond the exact reduction: fmod by 2 pi rounded (fmod is exact), so that every input gives the same
+ * bits; the angle is off by x * 2.4e-16 / (2 pi) (4e-11 rad at 1e6 rad). NaN and inf give NaN. */
+HM_MATH_FUNC double hm_math_far(double x) {
+    if (x != x || fabs(x) == HUGE_VAL) return x - x;
+    return fmod(x, 2.0 * HM_MATH_PI);
+}
+
+HM_MATH_FUNC double hm_math_sin(double x) {
+    int q;
+    double r;
+    if (!(fabs(x) < HM_MATH_REDUCE_MAX)) x = hm_math_far(x);
+    if (x == 0.0) return x; /* sin(-0) = -0 */
+    r = hm_math_reduce(x, &q);
+    if (q == 0) return hm_math_sin_kernel(r);
+    if (q == 1) return hm_math_cos_kernel(r);
+    if (q == 2) return -hm_math_sin_kernel(r);
+    return -hm_math_cos_kernel(r);
+}
+
+HM_MATH_FUNC double hm_math_cos(double x) {
+    int q;
+    double r;
+    if (!(fabs(x) < HM_MATH_REDUCE_MAX)) x = hm_math_far(x);
+    r = hm_math_reduce(x, &q);
+    if (q == 0) return hm_math_cos_kernel(r);
+    if (q == 1) return -hm_math_sin_kernel(r);
+    if (q == 2) return -hm_math_cos_kernel(r);
+    return hm_math_sin_kernel(r);
+}
+
+/* exp x = 2^k exp r, |r| <= ln2 / 2, exp r = 1 + r + r^2 (1/2! + r (1/3! + ...)): terms to r^13. */
+HM_MATH_FUNC double hm_math_exp(double x) {
+    static const double c[12] = {0.5,                   0.16666666666666666,   0.041666666666666664,
+                                 0.008333333333333333,  0.001388888888888889,  0.0001984126984126984,
+                                 2.48015873015873e-05,  2.7557319223985893e-06, 2.755731922398589e-07,
+                                 2.505210838544172e-08, 2.08767569878681e-09,  1.6059043836821613e-10};
+    double k, r;
+    if (x != x) return x;
+    if (x > 709.8) return HUGE_VAL;
+    if (x < -745.2) return 0.0;
+    k = floor(x * HM_MATH_INV_LN2 + 0.5);
+    r = (x - k * HM_MATH_LN2_HI) - k * HM_MATH_LN2_LO;
+    return ldexp(1.0 + (r + r * r * hm_math_horner(c, 12, r)), (int)k);
+}
+
+/* atan t for 0 <= t <= 1: above tan(pi/8), pi/4 + atan((t - 1) / (t + 1)), so that |t| <= tan(pi/8)
+ * where the series t (1 - z/3 + z^2/5 - ...) to t^43 suffices. */
+HM_MATH_FUNC double hm_math_atan01(double t) {
+    static const double c[22] = {1.0, -0.3333333333333333, 0.2, -0.14285714285714285, 0.1111111111111111, -0.09090909090909091, 0.07692307692307693, -0.06666666666666667, 0.058823529411764705, -0.05263157894736842, 0.047619047619047616, -0.043478260869565216, 0.04, -0.037037037037037035, 0.034482758620689655, -0.03225806451612903, 0.030303030303030304, -0.02857142857142857, 0.02702702702702703, -0.02564102564102564, 0.024390243902439025, -0.023255813953488372};
+    double base = 0.0;
+    if (t > HM_MATH_TAN_PI_8) {
+        base = HM_MATH_PI_4;
+        t = (t - 1.0) / (t + 1.0);
+    }
+    return base + t * hm_math_horner(c, 22, t * t);
+}
+
+/* C99's atan2, special values included (signed zeros, infinities, NaN). */
+HM_MATH_FUNC double hm_math_atan2(double y, double x) {
+    const double ax = fabs(x), ay = fabs(y);
+    double a;
+    if (x != x || y != y) return x + y;
+    if (ax == HUGE_VAL && ay == HUGE_VAL) a = HM_MATH_PI_4;
+    else if (ay > ax) a = HM_MATH_PI_2 - hm_math_atan01(ax / ay);
+    else if (ax == 0.0) a = 0.0;
+    else a = hm_math_atan01(ay / ax);
+    if (signbit(x)) a = HM_MATH_PI - a;
+    return signbit(y) ? -a : a;
+}
+
+/* ------------------------------------------------------------------------------------------------
+ * float: the same methods with single-precision constants and fewer terms, no double anywhere (a
+ * Cortex-M4F's FPU has single precision only).
+ * ------------------------------------------------------------------------------------------------ */
+
+/* pi/2 in parts of 12, 12 and 24 bits: k * part is exact for |k| < 2^12. */
+#define HM_MATH_PIO2_1F 1.57080078f
+#define HM_MATH_PIO2_2F (-4.45358455e-6f)
+#define HM_MATH_PIO2_3F (-8.70551575e-10f)
+#define HM_MATH_2_PIF 0.636619747f
+#define HM_MATH_REDUCE_MAXF 6433.0f /* 2^12 pi/2, rounded down */
+#define HM_MATH_PIF 3.14159274f
+#define HM_MATH_PI_2F 1.57079637f
+#define HM_MATH_PI_4F 0.785398185f
+#define HM_MATH_TAN_PI_8F 0.414213568f
+/* ln 2 in a 16-bit part and the rest: k * hi is exact for |k| < 2^8. */
+#define HM_MATH_LN2_HIF 0.693145752f
+#define HM_MATH_LN2_LOF 1.42860677e-6f
+#define HM_MATH_INV_LN2F 1.44269502f
+
+HM_MATH_FUNC float hm_math_hornerf(const float *c, int n, float z) {
+    float p = c[n - 1];
+    int i;
+    for (i = n - 2; i >= 0; --i) p = p * z + c[i];
+    return p;
+}
+
+/* Terms to r^11. */
+HM_MATH_FUNC float hm_math_sin_kernelf(float r) {
+    static const float c[5] = {-0.166666672f, 0.00833333377f, -0.000198412701f, 2.75573188e-6f, -2.50521079e-8f};
+    const float z = r * r;
+    return r + r * z * hm_math_hornerf(c, 5, z);
+}
+
+/* Terms to r^10. */
+HM_MATH_FUNC float hm_math_cos_kernelf(float r) {
+    static const float c[5] = {0.5f, -0.0416666679f, 0.00138888892f, -2.48015876e-5f, 2.755732e-7f};
+    const float z = r * r;
+    return 1.0f - z * hm_math_hornerf(c, 5, z);
+}
+
+HM_MATH_FUNC float hm_math_reducef(float x, int *quadrant) {
+    const float k = floorf(x * HM_MATH_2_PIF + 0.5f);
+    *quadrant = (int)(k - 4.0f * floorf(k * 0.25f));
+    return ((x - k * HM_MATH_PIO2_1F) - k * HM_MATH_PIO2_2F) - k * HM_MATH_PIO2_3F;
+}
+
+HM_MATH_FUNC float hm_math_farf(float x) {
+    if (x != x || fabsf(x) == HUGE_VALF) return x - x;
+    return fmodf(x, 2.0f * HM_MATH_PIF);
+}
+
+HM_MATH_FUNC float hm_math_sinf(float x) {
+    int q;
+    float r;
+    if (!(fabsf(x) < HM_MATH_REDUCE_MAXF)) x = hm_math_farf(x);
+    if (x == 0.0f) return x;
+    r = hm_math_reducef(x, &q);
+    if (q == 0) return hm_math_sin_kernelf(r);
+    if (q == 1) return hm_math_cos_kernelf(r);
+    if (q == 2) return -hm_math_sin_kernelf(r);
+    return -hm_math_cos_kernelf(r);
+}
+
+HM_MATH_FUNC float hm_math_cosf(float x) {
+    int q;
+    float r;
+    if (!(fabsf(x) < HM_MATH_REDUCE_MAXF)) x = hm_math_farf(x);
+    r = hm_math_reducef(x, &q);
+    if (q == 0) return hm_math_cos_kernelf(r);
+    if (q == 1) return -hm_math_sin_kernelf(r);
+    if (q == 2) return -hm_math_cos_kernelf(r);
+    return hm_math_sin_kernelf(r);
+}
+
+/* Terms to r^8. */
+HM_MATH_FUNC float hm_math_expf(float x) {
+    static const float c[7] = {0.5f,           0.166666672f,     0.0416666679f, 0.00833333377f,
+                               0.00138888892f, 0.000198412701f, 2.48015876e-5f};
+    float k, r;
+    if (x != x) return x;
+    if (x > 88.73f) return HUGE_VALF;
+    if (x < -103.98f) return 0.0f;
+    k = floorf(x * HM_MATH_INV_LN2F + 0.5f);
+    r = (x - k * HM_MATH_LN2_HIF) - k * HM_MATH_LN2_LOF;
+    return ldexpf(1.0f + (r + r * r * hm_math_hornerf(c, 7, r)), (int)k);
+}
+
+/* The series to t^21. */
+HM_MATH_FUNC float hm_math_atan01f(float t) {
+    static const float c[11] = {1.f, -0.333333343f, 0.200000003f, -0.142857149f, 0.111111112f, -0.0909090936f, 0.0769230798f, -0.0666666701f, 0.0588235296f, -0.0526315793f, 0.0476190485f};
+    float base = 0.0f;
+    if (t > HM_MATH_TAN_PI_8F) {
+        base = HM_MATH_PI_4F;
+        t = (t - 1.0f) / (t + 1.0f);
+    }
+    return base + t * hm_math_hornerf(c, 11, t * t);
+}
+
+HM_MATH_FUNC float hm_math_atan2f(float y, float x) {
+    const float ax = fabsf(x), ay = fabsf(y);
+    float a;
+    if (x != x || y != y) return x + y;
+    if (ax == HUGE_VALF && ay == HUGE_VALF) a = HM_MATH_PI_4F;
+    else if (ay > ax) a = HM_MATH_PI_2F - hm_math_atan01f(ax / ay);
+    else if (ax == 0.0f) a = 0.0f;
+    else a = hm_math_atan01f(ay / ax);
+    if (signbit(x)) a = HM_MATH_PIF - a;
+    return signbit(y) ? -a : a;
+}
+
+#endif /* HM_MATH_H */
