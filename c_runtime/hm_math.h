@@ -5,22 +5,26 @@
  * (glibc's sin against newlib's on the firmware, even glibc's own FMA and non-FMA variants). The
  * real-time iteration's warm start and the loop recovery amplify one bit into 1e-8 within a few
  * hundred periods, so the same controller gave other commands on a robot's computer than on its
- * Cortex-M. Built from +, -, *, / (IEEE, correctly rounded, not contracted under -std=c99) and the
- * exact floor and ldexp/ldexpf, these give the same bits on every C99 platform with IEEE arithmetic
- * and FLT_EVAL_METHOD 0 (x86-64 SSE, Arm VFP). Accuracy: within 3 ulp (double; 3.5 float) of the true value
- * (tests/test_portable_math.py measures it against glibc). The argument reduction of sin and cos is
+ * Cortex-M. Built from +, -, *, / (IEEE, correctly rounded, not contracted under -std=c99), integer
+ * conversion and the exact fmod and ldexp, these give the same bits on every C99 platform with IEEE
+ * arithmetic and FLT_EVAL_METHOD 0 (x86-64 SSE, Arm VFP). Accuracy: within 3 ulp (double; 3.5 float)
+ * of the true value (tests/test_portable_math.py measures it against glibc). The argument reduction of sin and cos is
  * exact for |x| < 8.2e5 rad (double) and 6.4e3 rad (float); beyond, an fmod by 2 pi makes them
  * less accurate but still the same everywhere (the controller's angles stay far inside).
  *
  * Self-contained on purpose: the CasADi-generated model file includes it as well
  * (codegen/casadi_emit.py renames its sin/cos/exp calls to these), so model and runtime share one
- * set of functions. Polynomials are Taylor's, kept until the first term left out is below 1e-17
- * (double) or 1e-9 (float) of the result; evaluated by Horner's rule from the highest term.
+ * set of functions. Polynomials: Taylor's series economised by Chebyshev polynomials on the reduced
+ * interval (exact rational arithmetic; what is left out is below 1e-18 (double) or 2e-10 (float) of the
+ * result), evaluated by Horner's rule from the highest term. No library call on the common path:
+ * rounding by integer conversion, 2^k built from its bits (ldexp only near overflow and underflow).
  */
 #ifndef HM_MATH_H
 #define HM_MATH_H
 
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 #if defined(__GNUC__)
 #define HM_MATH_FUNC static __attribute__((unused))
@@ -55,28 +59,31 @@ HM_MATH_FUNC double hm_math_horner(const double *c, int n, double z) {
     return p;
 }
 
-/* sin r = r + r z (-1/3! + z (1/5! - ...)), z = r^2, |r| <= pi/4: terms to r^19. */
+/* sin r = r + r z P(z), z = r^2, |r| <= pi/4 (P: -1/3! + z/5! - ..., economised to degree 6). */
 HM_MATH_FUNC double hm_math_sin_kernel(double r) {
-    static const double c[9] = {-0.16666666666666666,    0.008333333333333333,  -0.0001984126984126984,
-                                2.7557319223985893e-06,  -2.505210838544172e-08, 1.6059043836821613e-10,
-                                -7.647163731819816e-13,  2.8114572543455206e-15, -8.22063524662433e-18};
+    static const double c[7] = {-0.16666666666666666,    0.008333333333333331,   -0.00019841269841265065,
+                                2.755731921933988e-06,   -2.5052106232666854e-08, 1.605853165014853e-10,
+                                -7.586698778125347e-13};
     const double z = r * r;
-    return r + r * z * hm_math_horner(c, 9, z);
+    return r + r * z * hm_math_horner(c, 7, z);
 }
 
-/* cos r = 1 - z (1/2! - z (1/4! - ...)): terms to r^18. */
+/* cos r = 1 - z Q(z) (Q: 1/2! - z/4! + ..., economised to degree 6). */
 HM_MATH_FUNC double hm_math_cos_kernel(double r) {
-    static const double c[9] = {0.5,                    -0.041666666666666664, 0.001388888888888889,
-                                -2.48015873015873e-05,  2.755731922398589e-07, -2.08767569878681e-09,
-                                1.1470745597729725e-11, -4.779477332387385e-14, 1.5619206968586225e-16};
+    static const double c[7] = {0.5,                     -0.04166666666666664,  0.0013888888888880777,
+                                -2.4801587293694825e-05, 2.7557315566764273e-07, -2.0875886798171374e-09,
+                                1.1368001863024335e-11};
     const double z = r * r;
-    return 1.0 - z * hm_math_horner(c, 9, z);
+    return 1.0 - z * hm_math_horner(c, 7, z);
 }
 
-/* x = k pi/2 + r with |r| <= pi/4 (and rounding); the quadrant k mod 4 in 0..3. */
+/* x = k pi/2 + r with |r| <= pi/4 (and rounding), k rounded half away from zero by conversion (exact
+ * for |x| < HM_MATH_REDUCE_MAX); the quadrant k mod 4 in 0..3. */
 HM_MATH_FUNC double hm_math_reduce(double x, int *quadrant) {
-    const double k = floor(x * HM_MATH_2_PI + 0.5);
-    *quadrant = (int)(k - 4.0 * floor(k * 0.25));
+    const double t = x * HM_MATH_2_PI;
+    const long ki = (long)(t < 0.0 ? t - 0.5 : t + 0.5);
+    const double k = (double)ki;
+    *quadrant = (int)(((ki % 4) + 4) % 4);
     return ((x - k * HM_MATH_PIO2_1) - k * HM_MATH_PIO2_2) - k * HM_MATH_PIO2_3;
 }
 
@@ -110,31 +117,49 @@ HM_MATH_FUNC double hm_math_cos(double x) {
     return hm_math_sin_kernel(r);
 }
 
-/* exp x = 2^k exp r, |r| <= ln2 / 2, exp r = 1 + r + r^2 (1/2! + r (1/3! + ...)): terms to r^13. */
+/* 2^k for an integer k, from its IEEE bits where 2^k is a normal double (exact either way). */
+HM_MATH_FUNC double hm_math_pow2(double y, int k) {
+    uint64_t bits;
+    double scale;
+    if (k < -1022 || k > 1023) return ldexp(y, k);
+    bits = (uint64_t)(k + 1023) << 52;
+    memcpy(&scale, &bits, sizeof scale);
+    return y * scale;
+}
+
+/* exp x = 2^k exp r, |r| <= ln2 / 2, exp r = 1 + r + r^2 E(r) (E: 1/2! + r/3! + ..., economised to
+ * degree 10). */
 HM_MATH_FUNC double hm_math_exp(double x) {
-    static const double c[12] = {0.5,                   0.16666666666666666,   0.041666666666666664,
-                                 0.008333333333333333,  0.001388888888888889,  0.0001984126984126984,
-                                 2.48015873015873e-05,  2.7557319223985893e-06, 2.755731922398589e-07,
-                                 2.505210838544172e-08, 2.08767569878681e-09,  1.6059043836821613e-10};
-    double k, r;
+    static const double c[11] = {0.5,                   0.1666666666666667,     0.04166666666666668,
+                                 0.008333333333326136,  0.0013888888888879075,  0.00019841269874817515,
+                                 2.480158733643862e-05, 2.75572554044176e-06,   2.7557263283119803e-07,
+                                 2.510521516564936e-08, 2.091813619824862e-09};
+    double t, k, r;
+    int ki;
     if (x != x) return x;
     if (x > 709.8) return HUGE_VAL;
     if (x < -745.2) return 0.0;
-    k = floor(x * HM_MATH_INV_LN2 + 0.5);
+    t = x * HM_MATH_INV_LN2;
+    ki = (int)(t < 0.0 ? t - 0.5 : t + 0.5);
+    k = (double)ki;
     r = (x - k * HM_MATH_LN2_HI) - k * HM_MATH_LN2_LO;
-    return ldexp(1.0 + (r + r * r * hm_math_horner(c, 12, r)), (int)k);
+    return hm_math_pow2(1.0 + (r + r * r * hm_math_horner(c, 11, r)), ki);
 }
 
-/* atan t for 0 <= t <= 1: above tan(pi/8), pi/4 + atan((t - 1) / (t + 1)), so that |t| <= tan(pi/8)
- * where the series t (1 - z/3 + z^2/5 - ...) to t^43 suffices. */
+/* atan t for 0 <= t <= 1: above tan(pi/8), pi/4 + atan((t - 1) / (t + 1)), so that |t| <= tan(pi/8),
+ * where atan t = t A(t^2) (A: 1 - z/3 + z^2/5 - ..., economised to degree 12). */
 HM_MATH_FUNC double hm_math_atan01(double t) {
-    static const double c[22] = {1.0, -0.3333333333333333, 0.2, -0.14285714285714285, 0.1111111111111111, -0.09090909090909091, 0.07692307692307693, -0.06666666666666667, 0.058823529411764705, -0.05263157894736842, 0.047619047619047616, -0.043478260869565216, 0.04, -0.037037037037037035, 0.034482758620689655, -0.03225806451612903, 0.030303030303030304, -0.02857142857142857, 0.02702702702702703, -0.02564102564102564, 0.024390243902439025, -0.023255813953488372};
+    static const double c[13] = {1.0,                  -0.33333333333333326,  0.1999999999999709,
+                                 -0.14285714285337822, 0.11111111085776028,   -0.0909090807401841,
+                                 0.07692281413729647,  -0.06666209585962121,  0.05876873797776205,
+                                 -0.05217554392604461, 0.04500432793207413,   -0.03340846548588704,
+                                 0.015133766371040192};
     double base = 0.0;
     if (t > HM_MATH_TAN_PI_8) {
         base = HM_MATH_PI_4;
         t = (t - 1.0) / (t + 1.0);
     }
-    return base + t * hm_math_horner(c, 22, t * t);
+    return base + t * hm_math_horner(c, 13, t * t);
 }
 
 /* C99's atan2, special values included (signed zeros, infinities, NaN). */
@@ -177,23 +202,25 @@ HM_MATH_FUNC float hm_math_hornerf(const float *c, int n, float z) {
     return p;
 }
 
-/* Terms to r^11. */
+/* P economised to degree 3. */
 HM_MATH_FUNC float hm_math_sin_kernelf(float r) {
-    static const float c[5] = {-0.166666672f, 0.00833333377f, -0.000198412701f, 2.75573188e-6f, -2.50521079e-8f};
+    static const float c[4] = {-0.166666672f, 0.00833333191f, -0.00019840087f, 2.72499619e-06f};
     const float z = r * r;
-    return r + r * z * hm_math_hornerf(c, 5, z);
+    return r + r * z * hm_math_hornerf(c, 4, z);
 }
 
-/* Terms to r^10. */
+/* Q economised to degree 4. */
 HM_MATH_FUNC float hm_math_cos_kernelf(float r) {
-    static const float c[5] = {0.5f, -0.0416666679f, 0.00138888892f, -2.48015876e-5f, 2.755732e-7f};
+    static const float c[5] = {0.5f, -0.0416666679f, 0.00138888846f, -2.47998632e-05f, 2.72371665e-07f};
     const float z = r * r;
     return 1.0f - z * hm_math_hornerf(c, 5, z);
 }
 
 HM_MATH_FUNC float hm_math_reducef(float x, int *quadrant) {
-    const float k = floorf(x * HM_MATH_2_PIF + 0.5f);
-    *quadrant = (int)(k - 4.0f * floorf(k * 0.25f));
+    const float t = x * HM_MATH_2_PIF;
+    const int ki = (int)(t < 0.0f ? t - 0.5f : t + 0.5f);
+    const float k = (float)ki;
+    *quadrant = ((ki % 4) + 4) % 4;
     return ((x - k * HM_MATH_PIO2_1F) - k * HM_MATH_PIO2_2F) - k * HM_MATH_PIO2_3F;
 }
 
@@ -225,28 +252,40 @@ HM_MATH_FUNC float hm_math_cosf(float x) {
     return hm_math_sin_kernelf(r);
 }
 
-/* Terms to r^8. */
+HM_MATH_FUNC float hm_math_pow2f(float y, int k) {
+    uint32_t bits;
+    float scale;
+    if (k < -126 || k > 127) return ldexpf(y, k);
+    bits = (uint32_t)(k + 127) << 23;
+    memcpy(&scale, &bits, sizeof scale);
+    return y * scale;
+}
+
+/* E economised to degree 5. */
 HM_MATH_FUNC float hm_math_expf(float x) {
-    static const float c[7] = {0.5f,           0.166666672f,     0.0416666679f, 0.00833333377f,
-                               0.00138888892f, 0.000198412701f, 2.48015876e-5f};
-    float k, r;
+    static const float c[6] = {0.5f, 0.166666672f, 0.0416664667f, 0.00833329838f, 0.00139336509f, 0.000198992857f};
+    float t, k, r;
+    int ki;
     if (x != x) return x;
     if (x > 88.73f) return HUGE_VALF;
     if (x < -103.98f) return 0.0f;
-    k = floorf(x * HM_MATH_INV_LN2F + 0.5f);
+    t = x * HM_MATH_INV_LN2F;
+    ki = (int)(t < 0.0f ? t - 0.5f : t + 0.5f);
+    k = (float)ki;
     r = (x - k * HM_MATH_LN2_HIF) - k * HM_MATH_LN2_LOF;
-    return ldexpf(1.0f + (r + r * r * hm_math_hornerf(c, 7, r)), (int)k);
+    return hm_math_pow2f(1.0f + (r + r * r * hm_math_hornerf(c, 6, r)), ki);
 }
 
-/* The series to t^21. */
+/* A economised to degree 6. */
 HM_MATH_FUNC float hm_math_atan01f(float t) {
-    static const float c[11] = {1.f, -0.333333343f, 0.200000003f, -0.142857149f, 0.111111112f, -0.0909090936f, 0.0769230798f, -0.0666666701f, 0.0588235296f, -0.0526315793f, 0.0476190485f};
+    static const float c[7] = {1.f, -0.333333313f, 0.199998856f, -0.142816395f, 0.110410482f, -0.0845907703f,
+                               0.0471292883f};
     float base = 0.0f;
     if (t > HM_MATH_TAN_PI_8F) {
         base = HM_MATH_PI_4F;
         t = (t - 1.0f) / (t + 1.0f);
     }
-    return base + t * hm_math_hornerf(c, 11, t * t);
+    return base + t * hm_math_hornerf(c, 7, t * t);
 }
 
 HM_MATH_FUNC float hm_math_atan2f(float y, float x) {
