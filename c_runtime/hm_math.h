@@ -8,9 +8,10 @@
  * Cortex-M. Built from +, -, *, / (IEEE, correctly rounded, not contracted under -std=c99), integer
  * conversion and the exact fmod and ldexp, these give the same bits on every C99 platform with IEEE
  * arithmetic and FLT_EVAL_METHOD 0 (x86-64 SSE, Arm VFP). Accuracy: within 3 ulp (double; 3.5 float)
- * of the true value (tests/test_portable_math.py measures it against glibc). The argument reduction of sin and cos is
- * exact for |x| < 8.2e5 rad (double) and 6.4e3 rad (float); beyond, an fmod by 2 pi makes them
- * less accurate but still the same everywhere (the controller's angles stay far inside).
+ * of the true value (tests/test_portable_math.py measures it against glibc). The argument reduction
+ * of sin and cos is exact for |x| < 8.2e5 rad (double) and 6.4e3 rad (float); beyond, an fmod by
+ * 2 pi makes them less accurate but still the same everywhere (the controller's angles stay far
+ * inside).
  *
  * Self-contained on purpose: the CasADi-generated model file includes it as well
  * (codegen/casadi_emit.py renames its sin/cos/exp calls to these), so model and runtime share one
