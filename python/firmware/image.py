@@ -25,7 +25,8 @@ import struct
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -113,6 +114,23 @@ def package_spec(solver_dir: Path) -> Spec:
     return load_spec(Path(solver_dir) / "spec.yaml")
 
 
+# A replay compares arithmetic, not time: the host runs with the deadline at its largest (as the
+# controller replay, firmware/controller.py REPLAY_PARAMS), so that a loaded machine cannot turn a
+# slow step into a deadline stop that the other side (or the firmware, which has no clock) never makes.
+REPLAY_DEADLINE_MS = 1e5
+
+
+@contextmanager
+def without_deadline(solver: Solver) -> Iterator[Solver]:
+    """The solver with deadline_ms at REPLAY_DEADLINE_MS inside the block, its own value after."""
+    before = solver.params["deadline_ms"]
+    solver.set_params(deadline_ms=REPLAY_DEADLINE_MS)
+    try:
+        yield solver
+    finally:
+        solver.set_params(deadline_ms=before)
+
+
 def record_replay(solver: Solver, *, steps: int = 60, seed: int = 0, n_humans: int | None = None,
                   goal_distance: float = 8.0) -> Replay:
     """A closed loop driven by ``solver`` (the host library), recorded as a replay.
@@ -150,19 +168,20 @@ def record_replay(solver: Solver, *, steps: int = 60, seed: int = 0, n_humans: i
     goal = np.array([goal_distance, 0.0, 0.0, 0.8])
     solver.reset()
     records: list[dict[str, Any]] = []
-    for _ in range(steps):
-        pred = pos[None] + vel[None] * (dt * np.arange(N + 1))[:, None, None]
-        d = x[:2] - centre
-        obstacle = centre + radius * d / max(float(np.linalg.norm(d)), 1e-9)
-        rec = {"x0": x.copy(), "goal": goal.copy(), "humans_now": pos.copy(), "humans_pred": pred,
-               "obstacle": obstacle}
-        records.append(rec)
-        r = solver.step(**rec)
-        x = np.asarray(solver.model.dynamics(x, r.u0).x_next, dtype=np.float64)
-        pos = pos + vel * dt
-        out = (pos < lo) | (pos > hi)
-        vel = np.where(out, -vel, vel)
-        pos = np.clip(pos, lo, hi)
+    with without_deadline(solver):
+        for _ in range(steps):
+            pred = pos[None] + vel[None] * (dt * np.arange(N + 1))[:, None, None]
+            d = x[:2] - centre
+            obstacle = centre + radius * d / max(float(np.linalg.norm(d)), 1e-9)
+            rec = {"x0": x.copy(), "goal": goal.copy(), "humans_now": pos.copy(), "humans_pred": pred,
+                   "obstacle": obstacle}
+            records.append(rec)
+            r = solver.step(**rec)
+            x = np.asarray(solver.model.dynamics(x, r.u0).x_next, dtype=np.float64)
+            pos = pos + vel * dt
+            out = (pos < lo) | (pos > hi)
+            vel = np.where(out, -vel, vel)
+            pos = np.clip(pos, lo, hi)
     solver.reset()
     return Replay.from_steps(records, spec, scenario=f"firmware-crowd-{nh}-humans", seed=seed)
 
@@ -432,14 +451,15 @@ def host_results(solver: Solver, replay: Replay, *, cold: bool = False) -> list[
     every step, as the firmware does with cold=True."""
     from ..compare.replay import replay_solver
 
-    if not cold:
-        return list(replay_solver(solver, replay, keep_results=True).results)
-    solver.set_params(**replay.params)
-    results = []
-    for t in range(replay.steps):
-        solver.reset()
-        results.append(solver.step(**replay.inputs(t)))
-    return results
+    with without_deadline(solver):
+        if not cold:
+            return list(replay_solver(solver, replay, keep_results=True).results)
+        solver.set_params(**replay.params)
+        results = []
+        for t in range(replay.steps):
+            solver.reset()
+            results.append(solver.step(**replay.inputs(t)))
+        return results
 
 
 @dataclass(frozen=True)
