@@ -44,13 +44,17 @@ def planner_names() -> list[str]:
     return sorted(_PLANNERS)
 
 
-def make_planner(name: str) -> Planner:
-    """A fresh planner for ``name``; ``ValueError`` listing the registered names otherwise."""
+def planner_factory(name: str) -> PlannerFactory:
+    """The factory registered as ``name``; ``ValueError`` listing the registered names otherwise."""
     try:
-        factory = _PLANNERS[name]
+        return _PLANNERS[name]
     except KeyError:
         raise ValueError(f"unknown planner {name!r}; valid planners: {', '.join(planner_names())}") from None
-    return factory()
+
+
+def make_planner(name: str) -> Planner:
+    """A fresh planner for ``name``; ``ValueError`` listing the registered names otherwise."""
+    return planner_factory(name)()
 
 
 def _selected_solver() -> Solver:
