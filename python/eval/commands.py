@@ -127,6 +127,7 @@ def _evaluate(args: argparse.Namespace) -> int:
             scenarios, planners, list(range(args.first_seed, args.first_seed + args.seeds)), args.out,
             workers=args.workers, figures=not args.no_figures, progress=not args.quiet, config=config,
             crowds=args.crowds, grid=grid, scheduler=args.scheduler, traces=args.traces, fresh=args.fresh,
+            flush_every=args.flush_every,
         )
     except (SolverDirError, CampaignFolderError, CampaignEngineError, TaskFailedError, ValueError, KeyError) as err:
         print(f"error: {str(err).strip(chr(34))}", file=sys.stderr)
@@ -232,6 +233,9 @@ def add_evaluate_parser(subparsers: argparse._SubParsersAction) -> argparse.Argu
     p.add_argument("--out", type=output_dir, default=Path("out/evaluation"),
                    help="results folder (default out/evaluation); the same campaign run into it again runs only the "
                    "episodes it lacks")
+    p.add_argument("--flush-every", type=positive_int, default=50, metavar="N",
+                   help="write the results every N episodes (default 50; and every 10 s): what an interruption "
+                   "can cost")
     p.add_argument("--fresh", action="store_true",
                    help="delete the results of another campaign in --out first (without it, that is an error)")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")

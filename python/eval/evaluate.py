@@ -213,6 +213,7 @@ def evaluate(
     scheduler: str | None = None,
     traces: str = "first",
     fresh: bool = False,
+    flush_every: int = 50,
 ) -> EvaluationResult:
     """Run the campaign's missing episodes and write its tables, report and figures (module docstring).
 
@@ -220,7 +221,8 @@ def evaluate(
     existing Dask cluster instead. ``crowds``: the crowd models of the simulated scenarios; ``grid``: runtime
     parameter values of the planners that take them (every combination); ``traces``: which episodes keep
     their per-step trace (``first`` seed, ``all``, ``none``; the figures need the first); ``fresh``: delete
-    another campaign's results in ``out_dir`` instead of refusing. ``config``: the episodes' settings
+    another campaign's results in ``out_dir`` instead of refusing; ``flush_every``: episodes per Parquet part
+    (a part is also written every 10 s). ``config``: the episodes' settings
     (default ``EpisodeConfig()``; its horizon must be the MPC solver's N)."""
     validate_names(scenarios, planners, seeds)
     if not seeds:
@@ -235,7 +237,7 @@ def evaluate(
     tasks = campaign.tasks({name: planner_factory(name) for name in planners})
     engine = make_engine(workers, scheduler)
     try:
-        run_campaign(tasks, store, engine, progress=progress)
+        run_campaign(tasks, store, engine, progress=progress, flush_rows=flush_every)
     finally:
         engine.close()
     keys = {t.key for t in tasks}

@@ -272,8 +272,8 @@ def people_disturbance(velocities: FloatArray | None, undisturbed: FloatArray | 
     v, v0 = velocities[1:], undisturbed[1:]
     s, s0 = np.linalg.norm(v, axis=-1), np.linalg.norm(v0, axis=-1)
     moving = (s > DISTURBED_SPEED) & (s0 > DISTURBED_SPEED)
-    cos = np.sum(v * v0, axis=-1) / np.where(moving, s * s0, 1.0)
-    angle = np.where(moving, np.arccos(np.clip(cos, -1.0, 1.0)), 0.0)
+    cross = v[..., 0] * v0[..., 1] - v[..., 1] * v0[..., 0]
+    angle = np.where(moving, np.abs(np.arctan2(cross, np.sum(v * v0, axis=-1))), 0.0)  # exactly 0 for v = v0
     return float(np.sum(np.abs(s - s0))), float(np.sum(angle))
 
 

@@ -24,9 +24,10 @@ from typing import Any
 import pyarrow as pa
 
 from ..codegen.resources import generator_digest
+from ..codegen.spec import Spec
 from ..planners.interface import Planner
 from ..planners.registry import make_planner
-from ..planners.solver_dir import held_spec_hash, select_solver
+from ..planners.solver_dir import SolverChoice, held_spec_hash, select_solver, selected_solver
 from ..sim.scenarios import make_scenario
 from .campaign import EpisodeTask, SolverRef
 from .episode import run_episode
@@ -39,7 +40,6 @@ Row = dict[str, float | int | bool | str]
 MEASURED_COLUMNS = ("planner_ms_mean", "planner_ms_p99", "planner_ms_max", "wall_s", "worker")
 
 _lock = threading.Lock()
-_selected: SolverRef | None = None
 
 
 @dataclass(frozen=True)
@@ -54,20 +54,20 @@ class EpisodeResult:
 def use_solver(ref: SolverRef) -> None:
     """Make ``ref`` the solver of this process's MPC planners (module docstring); ``ValueError`` when its
     folder or spec is not the digest's."""
-    global _selected
+    folder = Path(ref.solver_dir) if ref.solver_dir is not None else None
     with _lock:
-        if _selected == ref:
+        if selected_solver() == SolverChoice(ref.spec, folder, ref.source):
             return
-        if ref.solver_dir is not None:
-            held = held_spec_hash(Path(ref.solver_dir))
+        if folder is not None:
+            held = held_spec_hash(folder)
             if held != ref.digest:
-                raise ValueError(f"worker {socket.gethostname()}: the solver folder {ref.solver_dir} holds spec sha256 "
+                raise ValueError(f"worker {socket.gethostname()}: the solver folder {folder} holds spec sha256 "
                                  f"{held or 'none'}, the campaign's is {ref.digest}: give the workers the same "
                                  "folder (a shared file system) or let them build the spec (--spec)")
-        elif ref.spec is not None and ref.spec.digest() != ref.digest:
-            raise ValueError(f"the task's spec has sha256 {ref.spec.digest()}, not the campaign's {ref.digest}")
-        select_solver(ref.spec, ref.solver_dir, ref.source)
-        _selected = ref
+        elif (ref.spec or Spec()).digest() != ref.digest:
+            raise ValueError(f"the task's spec has sha256 {(ref.spec or Spec()).digest()}, not the campaign's "
+                             f"{ref.digest}")
+        select_solver(ref.spec, folder, ref.source)
 
 
 def make_task_planner(task: EpisodeTask) -> Planner:

@@ -19,7 +19,8 @@ The robot is an agent for the people (``robot_visible``): before each step it is
 position with its velocity, so the people's constraints see it; its own new velocity is discarded
 (it moves by its planner). Reciprocity then assumes the robot takes half the avoidance, as in
 CrowdNav. Obstacles: polygons as they are (counter-clockwise, as RVO2 needs them), circles as the
-regular polygon of ``circle_sides`` sides around them.
+regular polygon of ``circle_sides`` sides around them. ORCA is a local method: a person whose straight
+way to their waypoint an obstacle blocks stays behind it (the social force model slides them along).
 
 The people's disturbance: a second simulator of the same people without the robot is set to the
 crowd's state before every step and stepped with the same preferred velocities; its velocities are
