@@ -206,30 +206,40 @@ def test_an_interrupted_campaign_resumes_without_repeating_or_losing_an_episode(
         assert same_row(row, reference.rows[row["key"]]) == []
 
 
-def test_a_killed_dask_campaign_resumes_without_repeating_or_losing_an_episode(
-        reference: Reference, default_dir: Path, tmp_path: Path,
-        capsys: pytest.CaptureFixture[str]) -> None:
-    """humanmpc-gen evaluate on a local cluster of 2 workers, killed (SIGKILL: no clean-up at all, its
-    workers with it) once some parts are written; the same command then runs exactly the missing episodes."""
-    out = tmp_path / "campaign"
-    argv = ["evaluate", *GRID, "--workers", "2", "--solver-dir", str(default_dir), "--out", str(out),
-            "--traces", "none", "--flush-every", "1", "--quiet", "--no-figures"]
+def _interrupt(argv: list[str], out: Path, parts: int, sig: int) -> int:
+    """Start humanmpc-gen (in its own process group), send ``sig`` to the group once ``parts`` Parquet parts
+    are there, return its exit code."""
     proc = subprocess.Popen([sys.executable, "-m", "humanmpc.cli", *argv], start_new_session=True,
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     try:
         deadline = time.monotonic() + 120
-        while len(list((out / "episodes").glob("part-*.parquet"))) < 3:
+        while len(list((out / "episodes").glob("part-*.parquet"))) < parts:
             assert proc.poll() is None, proc.stderr.read().decode() if proc.stderr else ""
             assert time.monotonic() < deadline, "no results after 120 s"
             time.sleep(0.02)
-        os.killpg(proc.pid, signal.SIGKILL)
+        os.killpg(proc.pid, sig)
+        return proc.wait(timeout=60)
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
-        proc.wait()
+            proc.wait()
+
+
+def test_a_terminated_then_killed_dask_campaign_resumes_without_repeating_or_losing_an_episode(
+        reference: Reference, default_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """humanmpc-gen evaluate on a local cluster of 2 workers: stopped by SIGTERM (it writes what it has,
+    logs the run as interrupted and exits 130), run again and killed by SIGKILL (no clean-up at all, its
+    workers with it); the same command then runs exactly the missing episodes."""
+    out = tmp_path / "campaign"
+    argv = ["evaluate", *GRID, "--workers", "2", "--solver-dir", str(default_dir), "--out", str(out),
+            "--traces", "none", "--flush-every", "1", "--quiet", "--no-figures"]
     store = ResultStore(out)
+    assert _interrupt(argv, out, 2, signal.SIGTERM) == 130
+    first = store.done_keys()
+    assert store.runs()[-1]["interrupted"] and store.runs()[-1]["ran"] == len(first)
+    assert _interrupt(argv, out, len(first) + 2, signal.SIGKILL) == -signal.SIGKILL
     done = store.done_keys()
-    assert 3 <= len(done) < 16
+    assert first < done and len(done) < 16
     capsys.readouterr()
     assert cli.main(argv) == 0
     err = capsys.readouterr().err

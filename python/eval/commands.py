@@ -24,7 +24,9 @@ interval T / N must be the simulation's control period, 0.1 s.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 from dataclasses import replace
 from pathlib import Path
 
@@ -121,6 +123,11 @@ def _evaluate(args: argparse.Namespace) -> int:
     except ValueError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
+    def terminated(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt  # SIGTERM (a batch system's notice) stops like Ctrl-C: the finished rows are written
+
+    previous = signal.signal(signal.SIGTERM, terminated) if threading.current_thread() is threading.main_thread() \
+        else None
     try:
         # makes each planner once before any episode: the MPC's solver is generated here if needed
         result = evaluate(
@@ -136,6 +143,9 @@ def _evaluate(args: argparse.Namespace) -> int:
         print(f"interrupted: the episodes finished so far are in {args.out}; run the same command again to "
               "resume", file=sys.stderr)
         return 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     print(markdown_table(result.summary))
     print(f"tables, report (report.md) and figures in {result.out_dir}")
     return 0
