@@ -136,7 +136,8 @@ def _evaluate(args: argparse.Namespace) -> int:
             crowds=args.crowds, grid=grid, scheduler=args.scheduler, traces=args.traces, fresh=args.fresh,
             flush_every=args.flush_every,
         )
-    except (SolverDirError, CampaignFolderError, CampaignEngineError, TaskFailedError, ValueError, KeyError) as err:
+    except (SolverDirError, CampaignFolderError, CampaignEngineError, TaskFailedError, ValueError, KeyError,
+            ImportError) as err:
         print(f"error: {str(err).strip(chr(34))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
@@ -156,7 +157,7 @@ def _report(args: argparse.Namespace) -> int:
 
     try:
         path = write_report(args.folder, args.out, figures=not args.no_figures)
-    except ValueError as err:
+    except (ValueError, ImportError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
     print(f"report: {path}")

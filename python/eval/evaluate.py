@@ -34,6 +34,7 @@ from ..sim.scenarios import SCENARIOS, check_seeds
 from .campaign import Campaign, EpisodeTask, ParamValue, PlannerConfig, SolverRef, grid_points
 from .engines import make_engine
 from .episode import EpisodeConfig
+from .extras import arrow, require
 from .report import write_report
 from .runner import run_campaign
 from .store import ResultStore
@@ -227,6 +228,10 @@ def evaluate(
     validate_names(scenarios, planners, seeds)
     if not seeds:
         raise ValueError("evaluate needs at least one seed")
+    arrow()  # the campaign extra, before any work
+    require("scipy.stats", "the report's intervals")
+    if scheduler is not None or workers > 0:
+        require("dask.distributed", "running episodes on Dask (--workers N >= 1, --scheduler; --workers 0 runs them here)")
     cfg = config or EpisodeConfig()
     solver = solver_ref()
     tunable = check_planners(planners, grid, solver, cfg)

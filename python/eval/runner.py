@@ -15,9 +15,8 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from datetime import datetime, timezone
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import pyarrow as pa
 from tqdm import tqdm
 
 from ..codegen.resources import generator_digest
@@ -25,6 +24,9 @@ from .campaign import EpisodeTask
 from .engines import Engine
 from .store import ResultStore
 from .worker import EpisodeResult, run_task
+
+if TYPE_CHECKING:
+    import pyarrow as pa
 
 
 class GeneratorMismatchError(RuntimeError):

@@ -14,7 +14,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
+
+from .extras import require
 
 LEVEL = 0.95
 
@@ -35,7 +36,7 @@ def wilson(successes: int, n: int, level: float = LEVEL) -> Interval:
         return Interval(math.nan, math.nan, math.nan, 0)
     if not 0 <= successes <= n:
         raise ValueError(f"wilson: need 0 <= successes <= n, got {successes} of {n}")
-    z = float(stats.norm.ppf(0.5 + level / 2))
+    z = float(require("scipy.stats", "the report's intervals").norm.ppf(0.5 + level / 2))
     p = successes / n
     centre = (p + z * z / (2 * n)) / (1 + z * z / n)
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
@@ -51,7 +52,8 @@ def mean_interval(values: Sequence[float], level: float = LEVEL) -> Interval:
     mean = float(np.mean(v))
     if v.size < 2:
         return Interval(mean, math.nan, math.nan, 1)
-    half = float(stats.t.ppf(0.5 + level / 2, v.size - 1)) * float(np.std(v, ddof=1)) / math.sqrt(v.size)
+    t = require("scipy.stats", "the report's intervals").t
+    half = float(t.ppf(0.5 + level / 2, v.size - 1)) * float(np.std(v, ddof=1)) / math.sqrt(v.size)
     return Interval(mean, mean - half, mean + half, int(v.size))
 
 

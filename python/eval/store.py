@@ -21,10 +21,12 @@ import re
 import shutil
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import pyarrow as pa
-import pyarrow.parquet as pq
+from .extras import arrow
+
+if TYPE_CHECKING:
+    import pyarrow as pa
 
 Row = dict[str, Any]
 
@@ -102,6 +104,7 @@ class ResultStore:
 
     def done_keys(self) -> set[str]:
         """The keys of the episodes that have a row."""
+        _, pq = arrow()
         keys: set[str] = set()
         for part in self._parts(self.episodes):
             keys.update(pq.read_table(part, columns=["key"]).column("key").to_pylist())
@@ -111,6 +114,7 @@ class ResultStore:
         """Write one part (module docstring); returns its rows file (None when there is nothing to write)."""
         if not rows:
             return None
+        pa, _ = arrow()
         parts = self._parts(self.episodes)
         number = int(_PART.fullmatch(parts[-1].name).group(1)) + 1 if parts else 0  # type: ignore[union-attr]
         name = f"part-{number:06d}.parquet"
@@ -126,6 +130,7 @@ class ResultStore:
     def read_rows(self) -> list[Row]:
         """Every row, in the order of their keys; columns a part lacks (a stop reason no episode of it had)
         read 0. ``ValueError`` if a key has two rows (a folder written by something else)."""
+        pa, pq = arrow()
         parts = [pq.read_table(p) for p in self._parts(self.episodes)]
         if not parts:
             return []
@@ -142,6 +147,7 @@ class ResultStore:
 
     def read_trace(self, key: str) -> pa.Table | None:
         """The per-step trace of episode ``key``, None if it kept none."""
+        _, pq = arrow()
         for part in self._parts(self.traces):
             table = pq.read_table(part, filters=[("key", "=", key)])
             if table.num_rows:
@@ -149,6 +155,7 @@ class ResultStore:
         return None
 
     def trace_keys(self) -> set[str]:
+        _, pq = arrow()
         keys: set[str] = set()
         for part in self._parts(self.traces):
             keys.update(pq.read_table(part, columns=["key"]).column("key").unique().to_pylist())
@@ -175,7 +182,7 @@ def _write_atomically(path: Path, data: bytes) -> None:
 
 def _write_table(table: pa.Table, path: Path) -> None:
     tmp = path.parent / f".{path.name}.tmp"
-    pq.write_table(table, tmp)
+    arrow()[1].write_table(table, tmp)
     with tmp.open("rb") as fh:
         os.fsync(fh.fileno())
     os.replace(tmp, path)

@@ -25,18 +25,22 @@ of the rebuilt log are those of the episode.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pyarrow as pa
 
 from ..sim.robot import RobotModel
 from ..sim.scenarios import Scenario
 from .episode import EpisodeLog
+from .extras import arrow
+
+if TYPE_CHECKING:
+    import pyarrow as pa
 
 
 def log_to_trace(key: str, log: EpisodeLog) -> pa.Table:
     """The per-step trace of ``log`` (module docstring)."""
+    pa, _ = arrow()
     n = log.states.shape[0]
     ids = log.human_ids if log.human_ids is not None else np.arange(log.humans.shape[1], dtype=np.int64)
     present = log.present

@@ -19,9 +19,7 @@ import threading
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
-
-import pyarrow as pa
+from typing import TYPE_CHECKING, Any
 
 from ..codegen.resources import generator_digest
 from ..codegen.spec import Spec
@@ -33,6 +31,9 @@ from .campaign import EpisodeTask, SolverRef
 from .episode import run_episode
 from .metrics import compute_metrics
 from .traces import log_to_trace
+
+if TYPE_CHECKING:
+    import pyarrow as pa
 
 Row = dict[str, float | int | bool | str]
 
