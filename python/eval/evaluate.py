@@ -231,7 +231,7 @@ def evaluate(
     arrow()  # the campaign extra, before any work
     require("scipy.stats", "the report's intervals")
     if scheduler is not None or workers > 0:
-        require("dask.distributed", "running episodes on Dask (--workers N >= 1, --scheduler; --workers 0 runs them here)")
+        require("dask.distributed", "running episodes on Dask (--workers N >= 1, --scheduler; --workers 0: here)")
     cfg = config or EpisodeConfig()
     solver = solver_ref()
     tunable = check_planners(planners, grid, solver, cfg)
