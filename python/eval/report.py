@@ -205,7 +205,9 @@ def episode_figures(store: ResultStore, rows: Sequence[Row], description: dict[s
         firsts.setdefault((scenario, crowd), seed)
     for (scenario, crowd), seed in firsts.items():
         logs = []
-        for r in sorted(by_cell[(scenario, crowd, seed)], key=lambda r: str(r["planner"])):
+        order = {p: i for i, p in enumerate(description.get("planners", []))}
+        for r in sorted(by_cell[(scenario, crowd, seed)],
+                        key=lambda r: (order.get(str(r["planner"]).split("[")[0], len(order)), str(r["planner"]))):
             trace = store.read_trace(str(r["key"]))
             assert trace is not None
             logs.append(trace_to_log(trace, make_scenario(scenario, seed), str(r["planner"]), str(r["ended_by"]),
