@@ -19,7 +19,7 @@ import threading
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ..codegen.resources import generator_digest
 from ..codegen.spec import Spec
@@ -103,7 +103,3 @@ def run_task(task: EpisodeTask) -> EpisodeResult:
     row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     return EpisodeResult(task.key, row, log_to_trace(task.key, log) if task.traces else None)
 
-
-def worker_info() -> dict[str, Any]:
-    """Where this runs (for messages): host, process, generator digest."""
-    return {"host": socket.gethostname(), "pid": os.getpid(), "generator_digest": generator_digest()[:12]}

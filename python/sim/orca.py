@@ -15,9 +15,10 @@ visited in order and switched within ``waypoint_radius`` (0.5 m), like the socia
 (:mod:`humanmpc.sim.crowd`), so every scenario's :class:`~humanmpc.sim.crowd.CrowdSpec` runs in
 either model (groups have no meaning in ORCA and are ignored).
 
-The robot is an agent for the people (``robot_visible``): before each step it is placed at its
-position with its velocity, so the people's constraints see it; its own new velocity is discarded
-(it moves by its planner). Reciprocity then assumes the robot takes half the avoidance, as in
+The robot is an agent for the people (``robot_visible``), of radius ``robot_radius`` 0.3 m (CrowdNav's
+robot; the evaluation's robot is 0.2 m, so people keep a 0.1 m margin from it): before each step it is
+placed at its position with its velocity, so the people's constraints see it; its own new velocity is
+discarded (it moves by its planner). Reciprocity then assumes the robot takes half the avoidance, as in
 CrowdNav. Obstacles: polygons as they are (counter-clockwise, as RVO2 needs them), circles as the
 regular polygon of ``circle_sides`` sides around them. ORCA is a local method: a person whose straight
 way to their waypoint an obstacle blocks stays behind it (the social force model slides them along).
