@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 from .codegen.cli import GENERATOR_ERRORS, add_generator_commands, make_parser, run
 from .compare.commands import add_bench_parser
-from .eval.commands import add_demo_parser, add_evaluate_parser, add_simulate_parser
+from .eval.commands import add_demo_parser, add_evaluate_parser, add_report_parser, add_simulate_parser
 from .firmware.commands import add_firmware_parser
 
 
@@ -18,6 +18,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     add_bench_parser(sub)
     add_simulate_parser(sub)
     add_evaluate_parser(sub)
+    add_report_parser(sub)
     add_firmware_parser(sub)
     add_demo_parser(sub)
     return run(parser, argv, GENERATOR_ERRORS)

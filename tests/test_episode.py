@@ -56,10 +56,13 @@ def test_evaluation_writes_tables_and_figures_with_parallel_workers(tmp_path: Pa
     assert [r["seed"] for r in result.rows] == [0, 1]
     with (tmp_path / "runs.csv").open() as fh:
         rows = list(csv.DictReader(fh))
-    assert len(rows) == 2 and {"success", "min_human_distance", "planner_ms_p99"} <= rows[0].keys()
+    assert len(rows) == 2 and {"success", "min_human_distance", "planner_ms_p99", "crowd"} <= rows[0].keys()
+    assert {r["worker"] for r in rows} != {""}
     table = (tmp_path / "summary.md").read_text()
-    assert table.startswith("| scenario | planner | runs |") and "| circle_crossing | dwb | 2 |" in table
-    assert (tmp_path / "figures" / "circle_crossing_seed0.png").is_file()
+    assert table.startswith("| scenario | crowd | planner | runs |")
+    assert "| circle_crossing | social_force | dwb | 2 |" in table
+    assert (tmp_path / "figures" / "circle_crossing_social_force_seed0.png").is_file()
+    assert "## Headline" in (tmp_path / "report.md").read_text()
 
 
 def test_planner_registry_builds_by_name_and_lists_valid_names() -> None:

@@ -6,7 +6,16 @@ import numpy as np
 import pytest
 
 from humanmpc.eval.episode import EpisodeLog
-from humanmpc.eval.metrics import compute_metrics, freezing, mean_jerk, omega_flip_rate, rising_edges
+from humanmpc.eval.metrics import (
+    TTC_CAP,
+    compute_metrics,
+    freezing,
+    mean_jerk,
+    omega_flip_rate,
+    people_disturbance,
+    rising_edges,
+    time_to_collision,
+)
 from humanmpc.sim.robot import RobotModel
 from humanmpc.sim.world import Circle, World
 
@@ -25,6 +34,8 @@ def make_log(
     reached: bool = True,
     stops: np.ndarray | None = None,
     reasons: list[str | None] | None = None,
+    velocities: np.ndarray | None = None,
+    undisturbed: np.ndarray | None = None,
 ) -> EpisodeLog:
     n = xy.shape[0]
     th = np.zeros(n) if theta is None else theta
@@ -39,6 +50,7 @@ def make_log(
         reasons=[None] * T if reasons is None else reasons,
         solve_ms=np.linspace(1.0, 2.0, T), plans=[None] * T,
         reached_goal=reached, ended_by="goal" if reached else "time_limit", present_mask=present,
+        human_velocities=velocities, undisturbed_velocities=undisturbed,
     )
 
 
@@ -257,3 +269,79 @@ def test_moving_away_from_the_goal_is_not_progress() -> None:
 def test_a_run_that_never_stops_does_not_freeze() -> None:
     m = compute_metrics(make_log(straight(), np.zeros((101, 0, 2)), speed=1.0))
     assert m.freezing_events == 0 and m.freezing_time == 0.0
+
+
+# SPL, time to collision, Hall's social space and the people's disturbance (issue 21), by hand.
+
+
+def test_spl_is_the_straight_distance_to_the_goal_circle_over_the_path_taken() -> None:
+    # goal 10.3 m ahead, tolerance 0.3 m: the shortest path is 10.0 m, the straight run takes exactly it
+    m = compute_metrics(make_log(straight(), np.zeros((101, 0, 2)), goal=(10.3, 0.0)))
+    assert m.spl == pytest.approx(1.0)
+    # a detour (0, 0) -> (3, 4) -> (6, 0), 5 + 5 m, to a goal at (6.3, 0): 6.0 / 10.0
+    leg = np.linspace(0.0, 1.0, 51)[:, None]
+    xy = np.vstack([leg * [3.0, 4.0], [3.0, 4.0] + leg[1:] * [3.0, -4.0]])
+    m = compute_metrics(make_log(xy, np.zeros((101, 0, 2)), goal=(6.3, 0.0)))
+    assert m.path_length == pytest.approx(10.0) and m.spl == pytest.approx(0.6)
+    # no success, no SPL: the same detour that touched someone, or that timed out
+    touched = compute_metrics(make_log(xy, np.tile([[3.0, 4.1]], (101, 1, 1)), goal=(6.3, 0.0)))
+    assert not touched.success and touched.spl == 0.0
+    assert compute_metrics(make_log(xy, np.zeros((101, 0, 2)), goal=(6.3, 0.0), reached=False)).spl == 0.0
+
+
+def test_time_to_collision_of_discs_at_constant_velocities() -> None:
+    r = 0.45
+    # head-on: 5 m apart, closing at 1 m/s, touching at 5 - 0.45 m
+    assert time_to_collision(np.array([5.0, 0.0]), np.array([-1.0, 0.0]), r) == pytest.approx(4.55)
+    # passing 0.3 m aside: (5 - t)^2 + 0.3^2 = 0.45^2  =>  t = 5 - sqrt(0.1125)
+    assert time_to_collision(np.array([5.0, 0.3]), np.array([-1.0, 0.0]), r) == pytest.approx(5 - np.sqrt(0.1125))
+    # passing 1 m aside, moving apart, standing still: never; touching: 0
+    assert np.isinf(time_to_collision(np.array([5.0, 1.0]), np.array([-1.0, 0.0]), r))
+    assert np.isinf(time_to_collision(np.array([5.0, 0.0]), np.array([1.0, 0.0]), r))
+    assert np.isinf(time_to_collision(np.array([5.0, 0.0]), np.array([0.0, 0.0]), r))
+    assert time_to_collision(np.array([0.3, 0.0]), np.array([1.0, 0.0]), r) == 0.0
+
+
+def test_min_time_to_collision_takes_the_robots_velocity_and_the_persons_tracked_one() -> None:
+    # the robot drives at 0.5 m/s along x from the origin; a person walks towards it at 1 m/s from x = 6
+    # (0.1 m per sample). Sample 0: the person's velocity is unknown (0): gap 6, closing 0.5 -> 11.1 s;
+    # from sample 1 on closing at 1.5 m/s: (6 - 0.15 t - 0.45) / 1.5 = 3.7 - 0.1 t s at sample t
+    n = 11
+    xy = np.column_stack([0.05 * np.arange(n), np.zeros(n)])
+    humans = np.column_stack([6.0 - 0.1 * np.arange(n), np.zeros(n)])[:, None, :]
+    m = compute_metrics(make_log(xy, humans, speed=0.5))
+    assert m.min_time_to_collision == pytest.approx(3.7 - 0.1 * (n - 1))
+    # the same person 2 m aside never comes within 0.45 m: the cap
+    aside = humans + np.array([0.0, 2.0])
+    assert compute_metrics(make_log(xy, aside, speed=0.5)).min_time_to_collision == TTC_CAP
+
+
+def test_time_in_hall_s_social_space_counts_samples_between_1_2_and_3_6_m() -> None:
+    # a person standing 2 m beside x = 5.05: 1.2 <= d always, d < 3.6 <=> |x - 5.05| < sqrt(3.6^2 - 2^2)
+    # = 2.993: x in {2.1, ..., 8.0}, 60 samples of 0.1 s
+    m = compute_metrics(make_log(straight(), np.tile([[5.05, 2.0]], (101, 1, 1))))
+    assert m.time_social == pytest.approx(6.0)
+    assert m.time_personal == 0.0 and m.time_intimate == 0.0
+
+
+def test_the_people_s_disturbance_sums_the_speed_and_heading_changes_the_robot_caused() -> None:
+    # one person walking at 1 m/s along x; v0: what they would have done without the robot
+    n = 6
+    v0 = np.tile([[1.0, 0.0]], (n, 1, 1))
+    v = v0.copy()
+    v[2, 0] = [0.6, 0.0]  # slowed by 0.4 m/s
+    v[3, 0] = [np.cos(np.pi / 6), np.sin(np.pi / 6)]  # turned by 30 degrees at the same speed
+    v0[4, 0] = v[4, 0] = [0.0, 0.01]  # standing: the direction is not compared
+    v[4, 0] = [0.03, 0.0]  # but the speed is: 0.02 m/s
+    speed, heading = people_disturbance(v, v0)
+    assert speed == pytest.approx(0.4 + 0.02)
+    assert heading == pytest.approx(np.pi / 6)
+    # sample 0 (the start) is no step and counts nothing
+    v[0, 0] = [0.0, 2.0]
+    assert people_disturbance(v, v0) == (pytest.approx(speed), pytest.approx(heading))
+    humans = np.cumsum(v * DT, axis=0)
+    m = compute_metrics(make_log(straight(n), humans, velocities=v, undisturbed=v0))
+    assert (m.people_speed_change, m.people_heading_change) == (pytest.approx(speed), pytest.approx(heading))
+    # people who do not react to the robot (recorded ones) have no disturbance
+    m = compute_metrics(make_log(straight(n), humans))
+    assert np.isnan(m.people_speed_change) and np.isnan(m.people_heading_change)

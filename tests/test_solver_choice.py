@@ -124,7 +124,7 @@ def test_simulate_with_a_spec_runs_the_mpc_on_that_spec_s_solver_from_the_cache_
     assert ensure_solver(spec=load_spec(spec)).resolve() == cached and not is_stale(cached)
 
 
-def test_evaluate_with_a_solver_dir_uses_it_as_it_is_in_its_forked_workers(
+def test_evaluate_with_a_solver_dir_uses_it_as_it_is_in_its_dask_workers(
         user_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     before = snapshot(user_dir)
     out = tmp_path / "evaluation"

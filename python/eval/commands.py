@@ -1,4 +1,4 @@
-"""``simulate``, ``evaluate`` and ``demo``: the evaluation's sub-commands of ``humanmpc-gen``.
+"""``simulate``, ``evaluate``, ``report`` and ``demo``: the evaluation's sub-commands of ``humanmpc-gen``.
 
 Hook them into the CLI's sub-parsers::
 
@@ -24,7 +24,9 @@ interval T / N must be the simulation's control period, 0.1 s.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 from dataclasses import replace
 from pathlib import Path
 
@@ -32,7 +34,7 @@ from ..codegen.cli import non_negative_int, output_dir, positive_int
 from ..codegen.spec import Spec, load_spec
 from ..planners.registry import planner_names
 from ..planners.solver_dir import CACHE_DIR, SolverDirError, check_solver_dir, select_solver
-from ..sim.scenarios import RECORDED_CROSSINGS, RECORDED_SCENARIOS, SCENARIOS, SIMULATED_SCENARIOS
+from ..sim.scenarios import CROWD_MODELS, RECORDED_CROSSINGS, RECORDED_SCENARIOS, SCENARIOS, SIMULATED_SCENARIOS
 from .episode import EpisodeConfig
 
 
@@ -82,7 +84,7 @@ def _simulate(args: argparse.Namespace) -> int:
         if args.animate:
             animation_path(args.animate)
         scenario = make_scenario(args.scenario, args.seed)
-        config = choose_solver(args.spec, args.solver_dir)
+        config = replace(choose_solver(args.spec, args.solver_dir), crowd_model=args.crowd)
         planner = make_planner(args.planner)  # an MPC planner generates and builds a --spec's solver here
     except ValueError as err:
         print(f"error: {err}", file=sys.stderr)
@@ -105,30 +107,75 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _evaluate(args: argparse.Namespace) -> int:
+    from .campaign import parse_grid
+    from .engines import CampaignEngineError, TaskFailedError
     from .evaluate import evaluate, markdown_table, validate_names
+    from .store import CampaignFolderError
 
     scenarios = args.scenarios or list(SIMULATED_SCENARIOS)
     planners = args.planners or planner_names()
     try:
         validate_names(scenarios, planners, range(args.first_seed, args.first_seed + args.seeds))
-        if args.seeds < 1 or args.workers < 1:
-            raise ValueError("--seeds and --workers must be >= 1")
+        if args.seeds < 1:
+            raise ValueError("--seeds must be >= 1")
+        grid = parse_grid(args.grid or [])
         config = choose_solver(args.spec, args.solver_dir)
     except ValueError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
+    def terminated(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt  # SIGTERM (a batch system's notice) stops like Ctrl-C: the finished rows are written
+
+    previous = signal.signal(signal.SIGTERM, terminated) if threading.current_thread() is threading.main_thread() \
+        else None
     try:
-        # makes each planner once before the workers fork: the MPC's solver is generated here if needed
+        # makes each planner once before any episode: the MPC's solver is generated here if needed
         result = evaluate(
             scenarios, planners, list(range(args.first_seed, args.first_seed + args.seeds)), args.out,
             workers=args.workers, figures=not args.no_figures, progress=not args.quiet, config=config,
+            crowds=args.crowds, grid=grid, scheduler=args.scheduler, traces=args.traces, fresh=args.fresh,
+            flush_every=args.flush_every,
         )
-    except SolverDirError as err:
+    except (SolverDirError, CampaignFolderError, CampaignEngineError, TaskFailedError, ValueError, KeyError,
+            ImportError) as err:
+        print(f"error: {str(err).strip(chr(34))}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"interrupted: the episodes finished so far are in {args.out}; run the same command again to "
+              "resume", file=sys.stderr)
+        return 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+    print(markdown_table(result.summary))
+    print(f"tables, report (report.md) and figures in {result.out_dir}")
+    return 0
+
+
+def _report(args: argparse.Namespace) -> int:
+    from .report import write_report
+
+    try:
+        path = write_report(args.folder, args.out, figures=not args.no_figures)
+    except (ValueError, ImportError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
-    print(markdown_table(result.summary))
-    print(f"tables and figures in {result.out_dir}")
+    print(f"report: {path}")
     return 0
+
+
+def add_report_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """``report DIR [--out FILE.md] [--no-figures]``: the report of a campaign's results folder."""
+    p = subparsers.add_parser("report", help="write the Markdown report (and figures) of an evaluation's results",
+                              description="Read the results folder of humanmpc-gen evaluate and write its report: "
+                              "rates with 95 %% Wilson intervals, means with 95 %% t intervals, units in every "
+                              "header, stops by reason, and the figures (DIR/report.md, DIR/figures/).")
+    p.add_argument("folder", type=Path, metavar="DIR", help="the --out folder of humanmpc-gen evaluate")
+    p.add_argument("--out", type=Path, metavar="FILE", help="the Markdown file (default DIR/report.md; the figures "
+                   "go to figures/ beside it)")
+    p.add_argument("--no-figures", action="store_true", help="tables only")
+    p.set_defaults(func=_report)
+    return p
 
 
 _RECORDED_SEEDS = (f"the recorded scenes ({', '.join(RECORDED_SCENARIOS)}) have seeds 0..{RECORDED_CROSSINGS - 1}, "
@@ -148,12 +195,14 @@ def add_solver_options(p: argparse.ArgumentParser) -> None:
 
 
 def add_simulate_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """``simulate --scenario NAME --planner NAME --seed S [--plot FILE] [--animate FILE.gif] [--spec FILE]
-    [--solver-dir DIR]``."""
+    """``simulate --scenario NAME --planner NAME --seed S [--crowd MODEL] [--plot FILE] [--animate FILE.gif]
+    [--spec FILE] [--solver-dir DIR]``."""
     p = subparsers.add_parser("simulate", help="run one closed-loop episode and print its metrics")
     p.add_argument("--scenario", required=True, help=f"one of: {', '.join(sorted(SCENARIOS))}")
     p.add_argument("--planner", required=True, help=f"a registered planner (now: {', '.join(planner_names())})")
     p.add_argument("--seed", type=non_negative_int, default=0, help=f"scenario seed (default 0); {_RECORDED_SEEDS}")
+    p.add_argument("--crowd", choices=CROWD_MODELS, default="social_force",
+                   help="how simulated people move (default social_force); recorded scenes replay theirs")
     p.add_argument("--plot", type=Path, help="write the paths figure to this file (.png/.svg/.pdf)")
     p.add_argument("--animate", type=Path, help="write an animated GIF of the episode to this file")
     add_solver_options(p)
@@ -162,18 +211,44 @@ def add_simulate_parser(subparsers: argparse._SubParsersAction) -> argparse.Argu
 
 
 def add_evaluate_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """``evaluate [--scenarios ...] [--planners ...] [--seeds N] [--workers W] [--out DIR] [--spec FILE]
-    [--solver-dir DIR]``."""
-    p = subparsers.add_parser("evaluate", help="run scenarios x planners x seeds and tabulate the metrics")
-    p.add_argument("--scenarios", nargs="+", help=f"any of {', '.join(sorted(SCENARIOS))}; default: the simulated "
+    """``evaluate [--scenarios ...] [--crowds ...] [--planners ...] [--grid NAME=V,...] [--seeds N] [--workers W |
+    --scheduler ADDRESS] [--traces first|all|none] [--out DIR] [--fresh] [--spec FILE] [--solver-dir DIR]``."""
+    p = subparsers.add_parser(
+        "evaluate", help="run scenarios x crowd models x planners x seeds (on Dask) and report the metrics",
+        description="An evaluation campaign: every scenario with every crowd model, every planner (the MPC "
+        "planners with every point of --grid), every seed; the episodes run on a local Dask cluster (--workers), "
+        "an existing one (--scheduler) or in this process (--workers 0), their rows stream to Parquet in --out, "
+        "and an interrupted campaign resumes where it stopped when run again. Writes runs.csv, summary.md, "
+        "safety.md, report.md (with confidence intervals) and figures/.")
+    p.add_argument("--scenarios", nargs="+", help=f"any of {', '.join(SCENARIOS)}; default: the simulated "
                    f"ones, {', '.join(SIMULATED_SCENARIOS)}")
     p.add_argument("--planners", nargs="+", help="default: every registered planner")
     p.add_argument("--seeds", type=positive_int, default=10,
                    help=f"number of seeds per scenario (default 10); {_RECORDED_SEEDS}")
     p.add_argument("--first-seed", type=non_negative_int, default=0, help="first seed (default 0)")
-    p.add_argument("--workers", type=positive_int, default=2, help="parallel worker processes (default 2)")
+    p.add_argument("--crowds", nargs="+", choices=CROWD_MODELS, default=["social_force"],
+                   help="crowd models of the simulated scenarios (default social_force); recorded scenes replay "
+                   "their people")
+    p.add_argument("--grid", action="append", metavar="NAME=V1,V2,...",
+                   help="a runtime parameter's values (humanmpc-gen keys; vectors as a:b:c:d), repeatable: the MPC "
+                   "planners run every combination, e.g. --grid q=10,50 --grid reaction_time=0.3,0.5")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=non_negative_int, default=2,
+                       help="worker processes of a local Dask cluster (default 2); 0: every episode in this process")
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="run on an existing Dask cluster, e.g. tcp://10.0.0.5:8786 (its workers need humanmpc "
+                       "with its campaign extra; each builds the solver into its own generated/.cache/)")
+    p.add_argument("--traces", choices=("first", "all", "none"), default="first",
+                   help="which episodes keep their per-step trace (traces/*.parquet): the first seed of every cell "
+                   "(default; the figures draw them), all, none")
     p.add_argument("--out", type=output_dir, default=Path("out/evaluation"),
-                   help="output folder (default out/evaluation)")
+                   help="results folder (default out/evaluation); the same campaign run into it again runs only the "
+                   "episodes it lacks")
+    p.add_argument("--flush-every", type=positive_int, default=50, metavar="N",
+                   help="write the results every N episodes (default 50; and every 10 s): what an interruption "
+                   "can cost")
+    p.add_argument("--fresh", action="store_true",
+                   help="delete the results of another campaign in --out first (without it, that is an error)")
     p.add_argument("--no-figures", action="store_true", help="skip the figures")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_solver_options(p)

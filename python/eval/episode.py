@@ -9,7 +9,12 @@ Per step (period ``dt``, 0.1 s by default):
 3. call the planner with an :class:`~humanmpc.planners.interface.Observation`;
 4. apply ``u`` to the robot for one period and step the crowd once, the robot taking part in
    the social force model as an agent at its state at the start of the period;
-5. log everything the metrics and plots need.
+5. log everything the metrics and plots need; for a crowd that reacts to the robot (a simulated one),
+   also the people's velocities and those the crowd model would have given them without the robot
+   (the disturbance metrics).
+
+Simulated people move by the crowd model of :attr:`EpisodeConfig.crowd_model` (social force or ORCA);
+recorded people are replayed whatever it says.
 
 The people present may change within an episode (recorded crowds: people enter and leave as
 recorded). The log keeps everyone who was ever present, in the order of their ids: ``humans``
@@ -33,9 +38,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..planners.interface import Observation, Planner
+from ..sim.crowd import ReactiveCrowd
+from ..sim.orca import OrcaParams
 from ..sim.predict import ConstantVelocityPredictor, Predictor
 from ..sim.robot import RobotModel, step, velocity_vector
-from ..sim.scenarios import Scenario
+from ..sim.scenarios import CROWD_MODELS, Scenario
 from ..sim.social_force import SocialForceParams
 from ..sim.world import World
 
@@ -52,12 +59,19 @@ class EpisodeConfig:
     social_force: SocialForceParams = field(default_factory=SocialForceParams)
     stop_on_collision: bool = False
     keep_plans: bool = True
+    crowd_model: str = "social_force"  # how simulated people move: CROWD_MODELS (recorded people are replayed)
+    orca: OrcaParams = field(default_factory=OrcaParams)
 
     def __post_init__(self) -> None:
         if abs(self.social_force.dt - self.dt) > 1e-12:
             raise ValueError(
                 f"EpisodeConfig: the crowd's dt {self.social_force.dt} must equal the control dt {self.dt}"
             )
+        if abs(self.orca.dt - self.dt) > 1e-12:
+            raise ValueError(f"EpisodeConfig: ORCA's dt {self.orca.dt} must equal the control dt {self.dt}")
+        if self.crowd_model not in CROWD_MODELS:
+            raise ValueError(f"EpisodeConfig: unknown crowd model {self.crowd_model!r}; crowd models: "
+                             f"{', '.join(CROWD_MODELS)}")
 
 
 @dataclass
@@ -87,6 +101,11 @@ class EpisodeLog:
     # (T + 1, K): who is present at each sample; None: everyone at every sample (a fixed crowd)
     present_mask: NDArray[np.bool_] | None = None
     human_ids: NDArray[np.int64] | None = None  # (K,): the crowd's id of each column; None: 0..K-1
+    # (T + 1, K, 2), reactive crowds only (else None): each person's velocity at every sample, and the velocity
+    # the crowd model gave them over the step that ends there without the robot, from the same state (the
+    # disturbance metrics); sample 0 holds the initial velocities in both
+    human_velocities: FloatArray | None = None
+    undisturbed_velocities: FloatArray | None = None
 
     def __post_init__(self) -> None:
         shape = self.humans.shape[:2]
@@ -101,6 +120,10 @@ class EpisodeLog:
             raise ValueError("EpisodeLog: humans has non-finite positions; give present_mask for people who are absent")
         if self.human_ids is not None and self.human_ids.shape != (shape[1],):
             raise ValueError(f"EpisodeLog: human_ids must have shape ({shape[1]},), got {self.human_ids.shape}")
+        for name in ("human_velocities", "undisturbed_velocities"):
+            v = getattr(self, name)
+            if v is not None and v.shape != self.humans.shape:
+                raise ValueError(f"EpisodeLog: {name} must have the shape of humans {self.humans.shape}, got {v.shape}")
 
     @property
     def steps(self) -> int:
@@ -146,7 +169,10 @@ def run_episode(
     pred = predictor or ConstantVelocityPredictor(cfg.horizon, cfg.dt)
     pred.reset()
     planner.reset()
-    crowd = scenario.start_crowd(cfg.social_force)
+    crowd = scenario.start_crowd(cfg.social_force, cfg.crowd_model, cfg.orca)
+    reactive = crowd if isinstance(crowd, ReactiveCrowd) else None  # simulated people react to the robot
+    velocities: list[FloatArray] = [reactive.velocities] if reactive else []
+    undisturbed: list[FloatArray] = [reactive.velocities] if reactive else []
     world, robot, goal = scenario.world, cfg.robot, np.asarray(scenario.goal, dtype=float)
     x = np.asarray(scenario.robot_start, dtype=float).copy()
     t = 0.0
@@ -180,6 +206,10 @@ def run_episode(
         states.append(x.copy())
         humans.append(crowd.positions)
         ids.append(crowd.ids)
+        if reactive is not None:
+            velocities.append(reactive.velocities)
+            without = reactive.undisturbed_velocities
+            undisturbed.append(velocities[-1] if without is None else without)
         if np.linalg.norm(x[:2] - goal[:2]) <= scenario.goal_tolerance:
             ended_by = "goal"
             break
@@ -211,4 +241,6 @@ def run_episode(
         ended_by=ended_by,
         present_mask=None if everyone_always else present,
         human_ids=human_ids,
+        human_velocities=np.array(velocities).reshape(people.shape) if reactive is not None else None,
+        undisturbed_velocities=np.array(undisturbed).reshape(people.shape) if reactive is not None else None,
     )

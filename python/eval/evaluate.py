@@ -1,61 +1,54 @@
-"""Batch evaluation: scenarios x planners x seeds in parallel, tables and figures.
+"""Evaluation campaigns: scenarios x crowd models x planners (x a runtime parameter grid) x seeds.
 
-Writes to ``out_dir``:
+:func:`evaluate` makes the campaign (:mod:`humanmpc.eval.campaign`), runs its missing episodes in this
+process or on a Dask cluster (:mod:`humanmpc.eval.engines`, :mod:`humanmpc.eval.runner`), streaming
+their rows to Parquet (:mod:`humanmpc.eval.store`), and writes to ``out_dir``:
 
-* ``runs.csv``: one row of :class:`~humanmpc.eval.metrics.EpisodeMetrics` per (scenario, planner, seed);
-* ``summary.csv`` and ``summary.md``: mean and standard deviation per scenario and planner
-  (rates for success / timeout, sums are not used: every number is a per-run mean);
-* ``safety.md``: per scenario and planner, totals over the runs: goals reached, contacts by
+* ``campaign.json``, ``episodes/*.parquet``, ``traces/*.parquet``, ``runs.jsonl``: the results folder;
+  running the same campaign into it again runs only the episodes it lacks;
+* ``runs.csv``: every row (one per scenario, crowd, planner and seed), for spreadsheets;
+* ``summary.csv`` and ``summary.md``: mean and standard deviation per scenario, crowd and planner
+  (rates for success / timeout; every number is a per-run mean);
+* ``safety.md``: per scenario, crowd and planner, totals over the runs: goals reached, contacts by
   fault (events and steps), the median of the runs' minimum distances, the time in protective
   stop and freezing (:func:`safety_table`);
-* ``figures/<scenario>_seed<first seed>.png``: the paths of every planner on the first seed.
+* ``report.md`` and ``figures/``: the report with confidence intervals (:mod:`humanmpc.eval.report`).
+
+Tables carry a crowd column when their rows have one (every campaign row does).
 """
 
 from __future__ import annotations
 
 import csv
 import math
-import multiprocessing as mp
 from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import partial
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
-from ..planners.registry import make_planner, planner_names
-from ..sim.scenarios import SCENARIOS, check_seeds, make_scenario
-from .episode import EpisodeConfig, EpisodeLog, run_episode
-from .metrics import compute_metrics
-from .plots import plot_episodes
+from ..codegen.spec import Spec
+from ..planners.registry import planner_factory, planner_names
+from ..planners.solver_dir import held_spec_hash, selected_solver
+from ..sim.scenarios import SCENARIOS, check_seeds
+from .campaign import Campaign, EpisodeTask, ParamValue, PlannerConfig, SolverRef, grid_points
+from .engines import make_engine
+from .episode import EpisodeConfig
+from .extras import arrow, require
+from .report import write_report
+from .runner import run_campaign
+from .store import ResultStore
+from .worker import make_task_planner
 
 SUMMARY_COLUMNS = [
-    "success", "collisions", "robot_fault_contacts", "person_fault_contacts", "timeout", "time_to_goal",
-    "path_length", "min_human_distance", "time_within_dth", "time_intimate", "time_personal", "protective_stops",
-    "stop_time", "freezing_time", "path_irregularity", "mean_jerk", "omega_flip_rate", "planner_ms_mean",
+    "success", "spl", "collisions", "robot_fault_contacts", "person_fault_contacts", "timeout", "time_to_goal",
+    "path_length", "min_human_distance", "min_time_to_collision", "time_within_dth", "time_intimate",
+    "time_personal", "time_social", "protective_stops", "stop_time", "freezing_time", "path_irregularity",
+    "mean_jerk", "omega_flip_rate", "people_speed_change", "people_heading_change", "planner_ms_mean",
     "planner_ms_p99", "planner_ms_max",
 ]
 
-
-@dataclass(frozen=True)
-class Job:
-    scenario: str
-    planner: str
-    seed: int
-    keep_log: bool
-
-
 Row = dict[str, float | int | bool | str]
-
-
-def run_job(job: Job, config: EpisodeConfig | None = None) -> tuple[Row, EpisodeLog | None]:
-    """Run one episode and return its metrics row (and its log if asked)."""
-    log = run_episode(make_scenario(job.scenario, job.seed), make_planner(job.planner), config)
-    log.planner = job.planner  # the registered name (a planner's own name may differ), for the figures
-    row: Row = {"scenario": job.scenario, "planner": job.planner, "seed": job.seed}
-    row.update(compute_metrics(log).as_row())
-    return row, (log if job.keep_log else None)
 
 
 def validate_names(scenarios: Sequence[str], planners: Sequence[str], seeds: Sequence[int] = ()) -> None:
@@ -72,15 +65,33 @@ def validate_names(scenarios: Sequence[str], planners: Sequence[str], seeds: Seq
         raise ValueError(f"unknown planner(s) {', '.join(bad_p)}; valid planners: {', '.join(valid_p)}")
 
 
+def _group_keys(rows: Sequence[Row]) -> list[tuple[str, ...]]:
+    """(scenario, crowd, planner) of the rows, or (scenario, planner) when they carry no crowd."""
+    if any("crowd" in r for r in rows):
+        return sorted({(str(r["scenario"]), str(r.get("crowd", "")), str(r["planner"])) for r in rows})
+    return sorted({(str(r["scenario"]), str(r["planner"])) for r in rows})
+
+
+def _group(rows: Sequence[Row], key: tuple[str, ...]) -> list[Row]:
+    if len(key) == 3:
+        return [r for r in rows if (r["scenario"], r.get("crowd", ""), r["planner"]) == key]
+    return [r for r in rows if (r["scenario"], r["planner"]) == key]
+
+
+def _key_names(keys: Sequence[tuple[str, ...]]) -> list[str]:
+    return ["scenario", "crowd", "planner"] if keys and len(keys[0]) == 3 else ["scenario", "planner"]
+
+
 def summarize(rows: Sequence[Row]) -> list[Row]:
-    """Mean and std (population) of the summary columns per (scenario, planner)."""
-    keys = sorted({(str(r["scenario"]), str(r["planner"])) for r in rows})
+    """Mean and std (population) of the summary columns per (scenario, crowd, planner)."""
+    keys = _group_keys(rows)
+    names = _key_names(keys)
     out: list[Row] = []
-    for scen, plan in keys:
-        group = [r for r in rows if r["scenario"] == scen and r["planner"] == plan]
-        summary: Row = {"scenario": scen, "planner": plan, "runs": len(group)}
+    for key in keys:
+        group = _group(rows, key)
+        summary: Row = {**dict(zip(names, key, strict=True)), "runs": len(group)}
         for col in SUMMARY_COLUMNS:
-            vals = np.array([float(r[col]) for r in group], dtype=float)
+            vals = np.array([float(r.get(col, math.nan)) for r in group], dtype=float)
             vals = vals[np.isfinite(vals)]
             summary[f"{col}_mean"] = float(np.mean(vals)) if vals.size else math.nan
             summary[f"{col}_std"] = float(np.std(vals)) if vals.size else math.nan
@@ -100,10 +111,11 @@ def write_csv(rows: Sequence[Row], path: Path) -> None:
 
 def markdown_table(summary: Sequence[Row]) -> str:
     """The summary as a Markdown table, ``mean ± std`` per cell."""
-    header = ["scenario", "planner", "runs", *SUMMARY_COLUMNS]
+    names = ["scenario", "crowd", "planner"] if summary and "crowd" in summary[0] else ["scenario", "planner"]
+    header = [*names, "runs", *SUMMARY_COLUMNS]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for s in summary:
-        cells = [str(s["scenario"]), str(s["planner"]), str(s["runs"])]
+        cells = [*(str(s[n]) for n in names), str(s["runs"])]
         for col in SUMMARY_COLUMNS:
             m, sd = float(s[f"{col}_mean"]), float(s[f"{col}_std"])
             cells.append("n/a" if math.isnan(m) else f"{m:.3g} ± {sd:.2g}")
@@ -123,10 +135,12 @@ def safety_table(rows: Sequence[Row]) -> str:
     0.1 s each) by fault, runs with a robot-fault contact, the median of the runs' minimum
     centre distances to a person, the mean time in protective stop per run, freezing events
     (total) and the mean freezing time per run. Markdown."""
-    keys = sorted({(str(r["scenario"]), str(r["planner"])) for r in rows})
-    lines = [SAFETY_HEADER, "|" + "---|" * SAFETY_HEADER.count(" | ") + "---|"]
-    for scen, plan in keys:
-        group = [r for r in rows if r["scenario"] == scen and r["planner"] == plan]
+    keys = _group_keys(rows)
+    header = SAFETY_HEADER.replace("| scenario | planner |", "| scenario | crowd | planner |") \
+        if keys and len(keys[0]) == 3 else SAFETY_HEADER
+    lines = [header, "|" + "---|" * header.count(" | ") + "---|"]
+    for key in keys:
+        group = _group(rows, key)
 
         def total(col: str, group: list[Row] = group) -> int:
             return int(sum(int(r[col]) for r in group))
@@ -135,7 +149,7 @@ def safety_table(rows: Sequence[Row]) -> str:
             return float(np.mean([float(r[col]) for r in group]))
 
         cells = [
-            scen, plan, str(len(group)), f"{total('reached_goal')} / {len(group)}",
+            *key, str(len(group)), f"{total('reached_goal')} / {len(group)}",
             f"{total('robot_fault_contacts')} / {total('robot_fault_steps')}",
             str(sum(1 for r in group if int(r["robot_fault_contacts"]) or int(r["robot_fault_steps"]))),
             f"{total('person_fault_contacts')} / {total('person_fault_steps')}",
@@ -154,6 +168,37 @@ class EvaluationResult:
     figures: list[Path]
 
 
+def solver_ref() -> SolverRef:
+    """The solver this process's MPC planners load (:func:`humanmpc.planners.solver_dir.select_solver`), as
+    workers elsewhere can find it again."""
+    choice = selected_solver()
+    if choice.solver_dir is not None:
+        digest = held_spec_hash(choice.solver_dir) or ""
+        return SolverRef(digest, choice.spec, str(choice.solver_dir.resolve()), choice.source)
+    spec = choice.spec or Spec()
+    return SolverRef(spec.digest(), choice.spec, None, choice.source)
+
+
+def check_planners(planners: Sequence[str], grid: Sequence[tuple[str, Sequence[ParamValue]]],
+                   solver: SolverRef, config: EpisodeConfig) -> frozenset[str]:
+    """Make every planner once here, with every grid point for those that take runtime parameters, before
+    any episode: an MPC planner generates and builds its solver into this machine's cache if needed (so
+    local workers find it built), and a grid value that breaks its parameter's rule is told now. Returns
+    the planners that take runtime parameters."""
+    tunable: set[str] = set()
+    for name in planners:
+        task = EpisodeTask("", "social_force", PlannerConfig(name), 0, solver, config)
+        controller = getattr(make_task_planner(task), "controller", None)
+        if controller is not None and hasattr(controller, "set_params"):
+            tunable.add(name)
+            for point in grid_points(grid) if grid else []:
+                try:
+                    make_task_planner(EpisodeTask("", "social_force", PlannerConfig(name, point), 0, solver, config))
+                except (KeyError, ValueError) as err:
+                    raise ValueError(f"--grid {PlannerConfig(name, point).label}: {str(err).strip(chr(34))}") from None
+    return frozenset(tunable)
+
+
 def evaluate(
     scenarios: Sequence[str],
     planners: Sequence[str],
@@ -163,46 +208,52 @@ def evaluate(
     figures: bool = True,
     progress: bool = True,
     config: EpisodeConfig | None = None,
+    *,
+    crowds: Sequence[str] = ("social_force",),
+    grid: Sequence[tuple[str, Sequence[ParamValue]]] = (),
+    scheduler: str | None = None,
+    traces: str = "first",
+    fresh: bool = False,
+    flush_every: int = 50,
 ) -> EvaluationResult:
-    """Run every combination, write the tables (and figures) and return them; ``config``: the episodes'
-    settings (default ``EpisodeConfig()``; its horizon must be the MPC solver's N)."""
+    """Run the campaign's missing episodes and write its tables, report and figures (module docstring).
+
+    ``workers``: a local Dask cluster of that many worker processes, 0 for this process; ``scheduler``: an
+    existing Dask cluster instead. ``crowds``: the crowd models of the simulated scenarios; ``grid``: runtime
+    parameter values of the planners that take them (every combination); ``traces``: which episodes keep
+    their per-step trace (``first`` seed, ``all``, ``none``; the figures need the first); ``fresh``: delete
+    another campaign's results in ``out_dir`` instead of refusing; ``flush_every``: episodes per Parquet part
+    (a part is also written every 10 s). ``config``: the episodes' settings
+    (default ``EpisodeConfig()``; its horizon must be the MPC solver's N)."""
     validate_names(scenarios, planners, seeds)
     if not seeds:
         raise ValueError("evaluate needs at least one seed")
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    # One instance of each planner here, before the workers fork: one-time setup (the MPC generates
-    # and builds its solver into the cache when missing) must not run in two workers at once.
-    for name in planners:
-        make_planner(name)
-    first = seeds[0]
-    jobs = [Job(s, p, int(seed), figures and seed == first) for s in scenarios for p in planners for seed in seeds]
-    results: list[tuple[Row, EpisodeLog | None]] = []
-    bar = tqdm(total=len(jobs), desc="episodes", disable=not progress)
-    if workers <= 1:
-        for job in jobs:
-            results.append(run_job(job, config))
-            bar.update()
-    else:
-        # fork: the workers inherit planners registered at run time and the solver chosen for the MPC
-        # planners (humanmpc.planners.solver_dir.select_solver).
-        ctx = mp.get_context("fork")
-        with ctx.Pool(workers) as pool:
-            for res in pool.imap_unordered(partial(run_job, config=config), jobs):
-                results.append(res)
-                bar.update()
-    bar.close()
-    rows = sorted((r for r, _ in results), key=lambda r: (str(r["scenario"]), str(r["planner"]), int(r["seed"])))
+    arrow()  # the campaign extra, before any work
+    require("scipy.stats", "the report's intervals")
+    if scheduler is not None or workers > 0:
+        require("dask.distributed", "running episodes on Dask (--workers N >= 1, --scheduler; --workers 0: here)")
+    cfg = config or EpisodeConfig()
+    solver = solver_ref()
+    tunable = check_planners(planners, grid, solver, cfg)
+    campaign = Campaign(tuple(scenarios), tuple(crowds), tuple(planners), tuple(int(s) for s in seeds), solver, cfg,
+                        tuple((n, tuple(v)) for n, v in grid), tunable, traces)
+    store = ResultStore(out_dir)
+    store.open(campaign.description(), fresh=fresh)
+    tasks = campaign.tasks({name: planner_factory(name) for name in planners})
+    engine = make_engine(workers, scheduler)
+    try:
+        run_campaign(tasks, store, engine, progress=progress, flush_rows=flush_every)
+    finally:
+        engine.close()
+    keys = {t.key for t in tasks}
+    rows = sorted((r for r in store.read_rows() if r["key"] in keys),
+                  key=lambda r: (str(r["scenario"]), str(r["crowd"]), str(r["planner"]), int(r["seed"])))
     summary = summarize(rows)
+    out = store.root
     write_csv(rows, out / "runs.csv")
     write_csv(summary, out / "summary.csv")
     (out / "summary.md").write_text(markdown_table(summary))
     (out / "safety.md").write_text(safety_table(rows))
-    written: list[Path] = []
-    if figures:
-        logs = [log for _, log in results if log is not None]
-        for scen in scenarios:
-            mine = sorted((lg for lg in logs if lg.scenario == scen), key=lambda lg: list(planners).index(lg.planner))
-            if mine:
-                written.append(plot_episodes(mine, out / "figures" / f"{scen}_seed{first}.png"))
+    write_report(out, figures=figures)
+    written = sorted((out / "figures").glob("*.png")) if figures else []
     return EvaluationResult(rows, summary, out, written)

@@ -25,8 +25,27 @@ Definitions (distances to humans are centre-to-centre, robot centre to human cen
   end) that lasts more than 5 s is a freezing event; ``freezing_time`` is their total length;
 * success: the goal was reached within the time limit with no collision event at all;
 * time inside a distance band: ``dt`` times the number of control intervals whose starting
-  sample has the nearest human in that band; ``intimate`` is d < 0.45 m and ``personal`` is
-  0.45 m <= d < 1.2 m (Hall's proxemic zones), ``within_dth`` is d < d_th (1.0 m);
+  sample has the nearest human in that band; ``intimate`` is d < 0.45 m, ``personal`` is
+  0.45 m <= d < 1.2 m and ``social`` is 1.2 m <= d < 3.6 m (Hall's proxemic zones, on the centre
+  distance d), ``within_dth`` is d < d_th (1.0 m); seconds;
+* SPL (success weighted by path length, Anderson et al. 2018): ``success * l / max(p, l)`` with p the
+  robot's path length and l the straight-line distance from its start to the goal's tolerance circle
+  (``|start - goal| - goal_tolerance``): the shortest path when no obstacle stands between them, a
+  lower bound otherwise (so SPL is pessimistic in cluttered scenes); 0..1;
+* minimum time to collision (s): at every sample and for every person present, the time until the
+  robot's disc and the person's would touch (centre distance robot radius + human radius) if both
+  kept their velocities: the robot's ``v (cos theta, sin theta)``, the person's the backward
+  difference of their last two logged positions (what a tracker sees; 0 at their first sample); 0
+  in contact; the minimum over the episode, capped at ``TTC_CAP`` = 10 s (never on a collision
+  course within 10 s reads 10 s);
+* the people's disturbance, in crowds that react to the robot (simulated ones; NaN for recorded
+  people, who do not): at every step the crowd model's velocity v of every person is compared with
+  v0, the velocity the same model gives them over the same step from the same state without the
+  robot (:attr:`EpisodeLog.undisturbed_velocities`). ``people_speed_change`` is the sum over the
+  steps and people of ``| |v| - |v0| |`` (m/s: the speed changes the robot caused, in total), and
+  ``people_heading_change`` the sum of the angle between v and v0 where both are faster than
+  0.05 m/s (rad: the turning it caused, in total). A person the robot slowed from 1.2 to 0.4 m/s
+  over a few steps adds 0.8 m/s, one it turned by 30 degrees adds 0.52 rad;
 * protective stops: events (rising edges of the planner's ``stop`` flag), counted per reason
   of the first step of each event, and the time spent in protective stop (``stop_time``: dt
   times the control steps whose planner result was a stop);
@@ -56,8 +75,11 @@ from .episode import EpisodeLog
 
 FloatArray = NDArray[np.float64]
 
-INTIMATE = 0.45
+INTIMATE = 0.45  # m, Hall's zones on the centre distance
 PERSONAL = 1.2
+SOCIAL = 3.6
+TTC_CAP = 10.0  # s: a longer time to collision reads as this
+DISTURBED_SPEED = 0.05  # m/s: below it a person's walking direction is not compared
 D_TH = 1.0
 MOVING_SPEED = 0.05  # m/s: above it the robot moves (contact attribution)
 FREEZE_TIME = 5.0  # s without progress that make a freezing event
@@ -80,10 +102,13 @@ class EpisodeMetrics:
     person_fault_steps: int
     time_to_goal: float
     path_length: float
+    spl: float
     min_human_distance: float
+    min_time_to_collision: float
     time_within_dth: float
     time_intimate: float
     time_personal: float
+    time_social: float
     protective_stops: int
     stop_time: float
     freezing_events: int
@@ -94,6 +119,8 @@ class EpisodeMetrics:
     planner_ms_mean: float
     planner_ms_p99: float
     planner_ms_max: float
+    people_speed_change: float
+    people_heading_change: float
     stops_by_reason: dict[str, int] = field(default_factory=dict)
 
     def as_row(self) -> dict[str, float | int | bool | str]:
@@ -195,6 +222,61 @@ def time_in_band(distances: FloatArray, lo: float, hi: float, dt: float) -> floa
     return float(dt * np.count_nonzero((d >= lo) & (d < hi)))
 
 
+def spl(success: bool, positions: FloatArray, goal_xy: FloatArray, goal_tolerance: float) -> float:
+    """Success weighted by path length (module docstring)."""
+    shortest = max(float(np.linalg.norm(goal_xy - positions[0])) - goal_tolerance, 0.0)
+    taken = path_length(positions)
+    if not success:
+        return 0.0
+    return 1.0 if max(taken, shortest) == 0.0 else shortest / max(taken, shortest)
+
+
+def time_to_collision(rel_pos: FloatArray, rel_vel: FloatArray, radius: float) -> FloatArray:
+    """Time until two discs touch (centre distance ``radius``) at constant velocities, elementwise over
+    (..., 2) relative positions and velocities: 0 if they touch already, inf if they never will."""
+    c = np.sum(rel_pos * rel_pos, axis=-1) - radius**2
+    a = np.sum(rel_vel * rel_vel, axis=-1)
+    b = 2.0 * np.sum(rel_pos * rel_vel, axis=-1)
+    disc = b * b - 4.0 * a * c
+    approaching = (a > 0) & (b < 0) & (disc >= 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = (-b - np.sqrt(np.where(approaching, disc, 0.0))) / (2.0 * np.where(approaching, a, 1.0))
+    return np.where(c <= 0, 0.0, np.where(approaching, t, np.inf))
+
+
+def tracked_velocities(humans: FloatArray, present: NDArray[np.bool_], dt: float) -> FloatArray:
+    """(T, K, 2): each person's backward-difference velocity, 0 where they were not there a sample before."""
+    v = np.zeros_like(humans)
+    both = present[1:] & present[:-1]
+    v[1:] = np.where(both[..., None], (humans[1:] - humans[:-1]) / dt, 0.0)
+    return v
+
+
+def min_time_to_collision(states: FloatArray, humans: FloatArray, present: NDArray[np.bool_], dt: float,
+                          contact_distance: float) -> float:
+    """The smallest time to collision with anyone present over the episode, capped at TTC_CAP (s)."""
+    if humans.shape[1] == 0 or not np.any(present):
+        return TTC_CAP
+    robot_v = states[:, 3:4] * np.stack([np.cos(states[:, 2]), np.sin(states[:, 2])], axis=1)
+    rel_pos = np.where(present[..., None], humans - states[:, None, :2], 1e9)
+    rel_vel = tracked_velocities(np.where(present[..., None], humans, 0.0), present, dt) - robot_v[:, None, :]
+    ttc = np.where(present, time_to_collision(rel_pos, rel_vel, contact_distance), np.inf)
+    return float(min(np.min(ttc), TTC_CAP))
+
+
+def people_disturbance(velocities: FloatArray | None, undisturbed: FloatArray | None) -> tuple[float, float]:
+    """Total speed change (m/s) and heading change (rad) the robot caused the people (module docstring);
+    NaN, NaN for a crowd that does not react to the robot."""
+    if velocities is None or undisturbed is None:
+        return float("nan"), float("nan")
+    v, v0 = velocities[1:], undisturbed[1:]
+    s, s0 = np.linalg.norm(v, axis=-1), np.linalg.norm(v0, axis=-1)
+    moving = (s > DISTURBED_SPEED) & (s0 > DISTURBED_SPEED)
+    cross = v[..., 0] * v0[..., 1] - v[..., 1] * v0[..., 0]
+    angle = np.where(moving, np.abs(np.arctan2(cross, np.sum(v * v0, axis=-1))), 0.0)  # exactly 0 for v = v0
+    return float(np.sum(np.abs(s - s0))), float(np.sum(angle))
+
+
 def path_irregularity(states: FloatArray, goal_xy: FloatArray) -> float:
     to_goal = goal_xy[None, :] - states[:, :2]
     dist = np.linalg.norm(to_goal, axis=1)
@@ -245,8 +327,10 @@ def compute_metrics(log: EpisodeLog) -> EpisodeMetrics:
     n_events = len(rising_edges(contact))
     mean_ms, p99_ms, max_ms = timing_stats(log.solve_ms)
     reasons = stop_events(log.stops, log.reasons)
+    success = bool(log.reached_goal and n_events == 0)
+    speed_change, heading_change = people_disturbance(log.human_velocities, log.undisturbed_velocities)
     return EpisodeMetrics(
-        success=bool(log.reached_goal and n_events == 0),
+        success=success,
         reached_goal=bool(log.reached_goal),
         timeout=log.ended_by == "time_limit",
         collisions=n_events,
@@ -259,10 +343,14 @@ def compute_metrics(log: EpisodeLog) -> EpisodeMetrics:
         person_fault_steps=faults.person_steps,
         time_to_goal=float(log.times[-1]) if log.reached_goal else float("nan"),
         path_length=path_length(xy),
+        spl=spl(success, xy, log.goal[:2], log.goal_tolerance),
         min_human_distance=float(np.min(d_h)),
+        min_time_to_collision=min_time_to_collision(log.states, log.humans, log.present, log.dt,
+                                                    robot.radius + robot.human_radius),
         time_within_dth=time_in_band(d_h, 0.0, D_TH, log.dt),
         time_intimate=time_in_band(d_h, 0.0, INTIMATE, log.dt),
         time_personal=time_in_band(d_h, INTIMATE, PERSONAL, log.dt),
+        time_social=time_in_band(d_h, PERSONAL, SOCIAL, log.dt),
         protective_stops=int(sum(reasons.values())),
         stop_time=float(log.dt * np.count_nonzero(log.stops)),
         freezing_events=freezing_events,
@@ -273,5 +361,7 @@ def compute_metrics(log: EpisodeLog) -> EpisodeMetrics:
         planner_ms_mean=mean_ms,
         planner_ms_p99=p99_ms,
         planner_ms_max=max_ms,
+        people_speed_change=speed_change,
+        people_heading_change=heading_change,
         stops_by_reason=reasons,
     )

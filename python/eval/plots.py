@@ -1,12 +1,17 @@
 """Figures of episodes in the spirit of the paper's (headless, Agg backend).
 
-* :func:`plot_episodes`: robot paths of one or more planners on the same scenario (MPC red,
-  DWB blue), human tracks with time-faded markers, obstacles, start and goal; below, the
-  distance to the nearest human and the planner time over time.
+* :func:`plot_episodes`: one map per episode given (robot path in its planner's colour, the people of
+  that episode, obstacles, start and goal, contacts marked); below, the distance to the nearest human
+  and the planner time over time, every episode in one plot each.
 * :func:`animate_episode`: an animated GIF of one episode (pillow writer).
 
-Simulated humans react to the robot, so their tracks differ between planners (recorded ones do
-not); the map shows the tracks of the first log given.
+People and planners never share colours: planners are drawn in saturated categorical colours (MPC red,
+DWB blue, the paper's MPC orange, others purple, brown, pink, olive), people in shades of green, each
+person's track a thin line from a hollow disc where they were first seen, with arrows every 1.5 s
+along it in their direction of walking (legend entry "people"). Contacts are marked at the robot's
+position where they start: a black cross where the robot was at fault (it moved with the person within
++-90 degrees of its heading, :func:`humanmpc.eval.metrics.robot_at_fault`), a white one where the person
+was. Simulated people react to the robot, so every episode has its own map.
 """
 
 from __future__ import annotations
@@ -23,19 +28,25 @@ import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon as PolygonPatch
 
 from ..sim.world import World
 from .episode import EpisodeLog
-from .metrics import D_TH, human_distances
+from .metrics import D_TH, human_distances, person_distances, rising_edges, robot_at_fault
 
 PLANNER_COLOURS = {"mpc": "tab:red", "dwb": "tab:blue", "mpc_paper": "tab:orange"}
-_OTHER = ["tab:green", "tab:purple", "tab:orange", "tab:brown"]
+_OTHER = ["tab:purple", "tab:brown", "tab:pink", "tab:olive"]
+PEOPLE_CMAP = "Greens"  # people: shades of green, never a planner's colour
+PEOPLE_COLOUR = "tab:green"  # their legend entry
+ARROW_EVERY = 1.5  # s between two arrows on a person's track
+ARROW_LENGTH = 0.35  # m
 
 
 def planner_colour(name: str, index: int = 0) -> str:
-    return PLANNER_COLOURS.get(name, _OTHER[index % len(_OTHER)])
+    """A planner's colour: by its registered name (the part before a parameter list ``mpc[q=10]``)."""
+    return PLANNER_COLOURS.get(name.split("[")[0], _OTHER[index % len(_OTHER)])
 
 
 def draw_world(ax: Axes, world: World) -> None:
@@ -51,27 +62,82 @@ def draw_world(ax: Axes, world: World) -> None:
     ax.set_ylabel("y [m]")
 
 
-def draw_humans(ax: Axes, log: EpisodeLog, every: int = 5) -> None:
-    """Human tracks as markers fading from light (start) to dark (end), each person's disc where
-    they were first seen (people absent at a sample have no marker there)."""
-    T, k = log.humans.shape[:2]
+def people_colours(k: int) -> list[tuple[float, float, float, float]]:
+    """``k`` shades of the people's colour map, distinguishable from one person to the next."""
+    cmap = plt.get_cmap(PEOPLE_CMAP)
+    return [cmap(0.45 + 0.5 * ((i * 0.618) % 1.0)) for i in range(k)]
+
+
+def draw_humans(ax: Axes, log: EpisodeLog) -> None:
+    """Every person's track (module docstring): a line, a hollow disc where first seen, arrows along the
+    direction of walking every ARROW_EVERY seconds (people absent at a sample have no point there)."""
+    k = log.humans.shape[1]
     if k == 0:
         return
-    idx = np.arange(0, T, every)
-    alpha = 0.15 + 0.75 * idx / max(T - 1, 1)
-    cmap = plt.get_cmap("tab10")
     present = log.present
-    for i in range(k):
-        seen = present[idx, i]
-        if not np.any(present[:, i]):
+    every = max(1, round(ARROW_EVERY / log.dt))
+    for i, colour in enumerate(people_colours(k)):
+        here = np.nonzero(present[:, i])[0]
+        if here.size == 0:
             continue
-        colour = np.array(cmap(i % 10))
-        rgba = np.tile(colour, (int(np.count_nonzero(seen)), 1))
-        rgba[:, 3] = alpha[seen]
-        ax.scatter(log.humans[idx[seen], i, 0], log.humans[idx[seen], i, 1], s=12, c=rgba, edgecolors="none",
-                   zorder=3)
-        first = log.humans[int(np.argmax(present[:, i])), i]
-        ax.add_patch(CirclePatch(first, log.robot.human_radius, fill=False, ec=colour, lw=1.0, zorder=3))
+        track = log.humans[here, i]
+        ax.plot(track[:, 0], track[:, 1], color=colour, lw=1.0, zorder=3)
+        ax.add_patch(CirclePatch(track[0], log.robot.human_radius, fill=False, ec=colour, lw=1.0, zorder=3))
+        at = np.arange(0, here.size - 1, every)
+        step = track[np.minimum(at + 1, here.size - 1)] - track[at]
+        norm = np.linalg.norm(step, axis=1)
+        moving = norm > 1e-6
+        if np.any(moving):
+            d = step[moving] / norm[moving, None] * ARROW_LENGTH
+            ax.quiver(track[at[moving], 0], track[at[moving], 1], d[:, 0], d[:, 1], color=colour, angles="xy",
+                      scale_units="xy", scale=1.0, width=0.006, headwidth=4, headlength=4, zorder=3)
+
+
+def contact_starts(log: EpisodeLog) -> tuple[np.ndarray, np.ndarray]:
+    """The samples at which a contact with a person starts, the robot's fault and the person's."""
+    r = log.robot.radius + log.robot.human_radius
+    contact = person_distances(log.states[:, :2], log.humans, log.present) < r
+    fault = robot_at_fault(log.states, log.humans) & contact
+    robot: list[int] = []
+    person: list[int] = []
+    for k in range(contact.shape[1]):
+        for t in rising_edges(contact[:, k]):
+            (robot if fault[t, k] else person).append(int(t))
+    return np.array(sorted(robot), dtype=int), np.array(sorted(person), dtype=int)
+
+
+def draw_contacts(ax: Axes, log: EpisodeLog) -> None:
+    robot, person = contact_starts(log)
+    xy = log.states[:, :2]
+    if robot.size:
+        ax.plot(xy[robot, 0], xy[robot, 1], ls="none", marker="X", ms=11, mfc="black", mec="white", zorder=6)
+    if person.size:
+        ax.plot(xy[person, 0], xy[person, 1], ls="none", marker="X", ms=11, mfc="white", mec="black", zorder=6)
+
+
+def legend_handles(colour: str, label: str) -> list[Line2D]:
+    """The map's legend: the robot's path, the people, the two contact marks, start and goal."""
+    return [
+        Line2D([], [], color=colour, lw=2.0, label=label),
+        Line2D([], [], color=PEOPLE_COLOUR, lw=1.0, marker=r"$\rightarrow$", ms=9,
+               label="people (arrows: walking direction)"),
+        Line2D([], [], ls="none", marker="X", ms=9, mfc="black", mec="white", label="contact, robot's fault"),
+        Line2D([], [], ls="none", marker="X", ms=9, mfc="white", mec="black", label="contact, person's fault"),
+        Line2D([], [], ls="none", marker="o", ms=8, mfc="white", mec="k", label="start"),
+        Line2D([], [], ls="none", marker="*", ms=12, color="gold", mec="k", label="goal"),
+    ]
+
+
+def draw_map(ax: Axes, log: EpisodeLog, colour: str) -> None:
+    """One episode on its map: world, people, robot path, contacts, start and goal, legend."""
+    draw_world(ax, log.world)
+    draw_humans(ax, log)
+    xy = log.states[:, :2]
+    ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=2.0, zorder=4)
+    draw_contacts(ax, log)
+    ax.plot(*xy[0], marker="o", ms=10, mfc="white", mec="k", zorder=5)
+    ax.plot(*log.goal[:2], marker="*", ms=15, color="gold", mec="k", zorder=5)
+    ax.legend(handles=legend_handles(colour, f"{log.planner} ({log.ended_by})"), loc="upper left", fontsize=7)
 
 
 def figure_path(path: str | Path) -> Path:
@@ -94,31 +160,27 @@ def animation_path(path: str | Path) -> Path:
 
 
 def plot_episodes(logs: Sequence[EpisodeLog], path: str | Path, title: str | None = None) -> Path:
-    """Write the paths figure (PNG, SVG or PDF by extension) and return its path."""
+    """Write the figure (PNG, SVG or PDF by extension; module docstring) and return its path."""
     if not logs:
         raise ValueError("plot_episodes needs at least one episode log")
     out = figure_path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig = plt.figure(figsize=(7.5, 10.0))
-    grid = fig.add_gridspec(3, 1, height_ratios=[3.2, 1, 1])
-    ax = fig.add_subplot(grid[0])
-    ax_d = fig.add_subplot(grid[1])
-    ax_t = fig.add_subplot(grid[2], sharex=ax_d)
+    n = len(logs)
+    fig = plt.figure(figsize=(max(7.5, 5.2 * n), 10.0))
+    grid = fig.add_gridspec(3, n, height_ratios=[3.2, 1, 1])
+    ax_d = fig.add_subplot(grid[1, :])
+    ax_t = fig.add_subplot(grid[2, :], sharex=ax_d)
     first = logs[0]
-    draw_world(ax, first.world)
-    draw_humans(ax, first)
-    for n, log in enumerate(logs):
-        colour = planner_colour(log.planner, n)
+    for i, log in enumerate(logs):
+        colour = planner_colour(log.planner, i)
+        ax = fig.add_subplot(grid[0, i])
+        draw_map(ax, log, colour)
+        ax.set_title(f"{log.planner}" if n > 1 else (title or f"{first.scenario}, seed {first.seed}"), fontsize=10)
         xy = log.states[:, :2]
-        ax.plot(xy[:, 0], xy[:, 1], color=colour, lw=2.0, label=f"{log.planner} ({log.ended_by})", zorder=4)
-        d = human_distances(xy, log.humans, log.present)
-        ax_d.plot(log.times, d, color=colour, label=log.planner)
+        ax_d.plot(log.times, human_distances(xy, log.humans, log.present), color=colour, label=log.planner)
         ax_t.plot(log.times[1:], log.solve_ms, color=colour, label=log.planner)
-    start, goal = first.states[0], first.goal
-    ax.plot(*start[:2], marker="o", ms=10, mfc="white", mec="k", zorder=5, label="start")
-    ax.plot(*goal[:2], marker="*", ms=15, color="gold", mec="k", zorder=5, label="goal")
-    ax.legend(loc="upper left", fontsize=8)
-    ax.set_title(title or f"{first.scenario}, seed {first.seed}")
+    if n > 1:
+        fig.suptitle(title or f"{first.scenario}, seed {first.seed}")
     r_sum = first.robot.radius + first.robot.human_radius
     ax_d.axhline(D_TH, color="0.5", ls="--", lw=1, label="d_th")
     ax_d.axhline(r_sum, color="k", ls=":", lw=1, label="contact")
@@ -146,7 +208,7 @@ def animate_episode(log: EpisodeLog, path: str | Path, fps: int = 10, stride: in
     robot = CirclePatch((0, 0), log.robot.radius, color=colour, zorder=6)
     ax.add_patch(robot)
     r_h = log.robot.human_radius
-    humans = [CirclePatch((0, 0), r_h, color="tab:gray", zorder=5) for _ in range(log.humans.shape[1])]
+    humans = [CirclePatch((0, 0), r_h, color=c, zorder=5) for c in people_colours(log.humans.shape[1])]
     for h in humans:
         ax.add_patch(h)
     text = ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", fontsize=9)

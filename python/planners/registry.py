@@ -4,15 +4,15 @@
 a fresh :class:`~humanmpc.planners.interface.Planner`. The DWB baseline is registered as ``"dwb"``, the
 generated C controller as ``"mpc"`` (the spec's defaults) and ``"mpc_paper"`` (the paper's parameters and
 the goal pose alone; :meth:`~humanmpc.planners.mpc.MPCPlanner.paper`).
-Evaluation workers are forked from the registering process, so registrations made before an
-evaluation starts are visible in the workers.
+An evaluation ships each task's factory with it (:func:`planner_factory`; Dask pickles it, a function of
+a script by value), so planners registered at run time run on workers that never registered them.
 
 The two MPC planners load the solver chosen for this process by
 :func:`~humanmpc.planners.solver_dir.select_solver` (re-exported here; the ``simulate``, ``evaluate``
 and ``demo`` commands call it with their ``--spec`` / ``--solver-dir`` before any planner is made, and
-forked workers inherit the choice); without a choice, the built-in default spec's solver in the
-tools' cache. A factory registered for another MPC configuration honours the choice by loading
-``ensure_solver()``.
+an evaluation's workers make the same choice from the task's solver reference); without a choice, the
+built-in default spec's solver in the tools' cache. A factory registered for another MPC configuration
+honours the choice by loading ``ensure_solver()``.
 """
 
 from __future__ import annotations
@@ -44,13 +44,17 @@ def planner_names() -> list[str]:
     return sorted(_PLANNERS)
 
 
-def make_planner(name: str) -> Planner:
-    """A fresh planner for ``name``; ``ValueError`` listing the registered names otherwise."""
+def planner_factory(name: str) -> PlannerFactory:
+    """The factory registered as ``name``; ``ValueError`` listing the registered names otherwise."""
     try:
-        factory = _PLANNERS[name]
+        return _PLANNERS[name]
     except KeyError:
         raise ValueError(f"unknown planner {name!r}; valid planners: {', '.join(planner_names())}") from None
-    return factory()
+
+
+def make_planner(name: str) -> Planner:
+    """A fresh planner for ``name``; ``ValueError`` listing the registered names otherwise."""
+    return planner_factory(name)()
 
 
 def _selected_solver() -> Solver:

@@ -18,8 +18,11 @@ Two kinds of solver folders, never mixed up:
 
 :func:`select_solver` chooses the solver of this process (the commands call it with their ``--spec``
 and ``--solver-dir`` before any planner is made): :func:`ensure_solver` without arguments returns
-it, and the registry's ``mpc`` and ``mpc_paper`` planners load it. Evaluation workers are forked
-after the choice and inherit it. Without a choice it is the built-in default spec, in the cache.
+it, and the registry's ``mpc`` and ``mpc_paper`` planners load it. An evaluation's workers (Dask
+processes, here or on other machines) make the same choice from each task's solver reference
+(:func:`humanmpc.eval.worker.use_solver`): the spec's solver from their own cache (the lock and the
+staging folder make concurrent builds of one spec safe), or the same folder. Without a choice it is the
+built-in default spec, in the cache.
 """
 
 from __future__ import annotations

@@ -10,6 +10,11 @@ two waypoints).
 The robot is an agent for the humans: pass its position and velocity to :meth:`Crowd.step`
 and it enters the human-human repulsion like any other person (it is not moved by forces).
 
+What the robot changes (the people's disturbance, :mod:`humanmpc.eval.metrics`): each step with the
+robot also computes, from the same state, the velocities the people would have taken without it
+(the same forces less the robot's repulsion), :attr:`Crowd.undisturbed_velocities`. The step itself
+is computed exactly as without that bookkeeping.
+
 :class:`HumanCrowd` is what a closed loop needs of any crowd: this simulated one (a fixed set of
 people, ids ``0..k-1``) and the replay of recorded people (:mod:`humanmpc.sim.recorded`, whose
 set changes as people enter and leave).
@@ -58,6 +63,19 @@ class HumanCrowd(Protocol):
 
     def step(self, robot_position: ArrayLike | None = None, robot_velocity: ArrayLike | None = None) -> None:
         """Advance one period; the robot's state is there for crowds that react to it."""
+
+
+@runtime_checkable
+class ReactiveCrowd(HumanCrowd, Protocol):
+    """A crowd whose people react to the robot (the simulated ones): their velocities (k, 2) [m/s] now, and
+    those the last step would have given them without the robot, from the same state (None before a step
+    with the robot)."""
+
+    @property
+    def velocities(self) -> FloatArray: ...
+
+    @property
+    def undisturbed_velocities(self) -> FloatArray | None: ...
 
 
 @dataclass(frozen=True)
@@ -141,6 +159,7 @@ class Crowd:
             self._group_id[list(members)] = g_index
         self._obstacle_samples = self.world.boundary_samples(self.params.obstacle_resolution)
         self._max_speed = self.params.max_speed_factor * self.spec.desired_speeds
+        self._undisturbed: FloatArray | None = None
 
     @property
     def size(self) -> int:
@@ -173,6 +192,12 @@ class Crowd:
 
     def forces(self, robot_position: ArrayLike | None = None, robot_velocity: ArrayLike | None = None) -> FloatArray:
         """Total social force on every human, (k, 2)."""
+        return self._forces(robot_position, robot_velocity)[0]
+
+    def _forces(self, robot_position: ArrayLike | None, robot_velocity: ArrayLike | None,
+                without_robot: bool = False) -> tuple[FloatArray, FloatArray | None]:
+        """The total force, and (``without_robot``, with a robot given) the total force less the robot's
+        repulsion, summed in the same order."""
         p = self.params
         goals = self.goals
         others_pos, others_vel = self._pos, self._vel
@@ -180,15 +205,42 @@ class Crowd:
             rv = np.zeros(2) if robot_velocity is None else np.asarray(robot_velocity, dtype=float).reshape(2)
             others_pos = np.vstack([self._pos, np.asarray(robot_position, dtype=float).reshape(1, 2)])
             others_vel = np.vstack([self._vel, rv.reshape(1, 2)])
-        f = desired_force(self._pos, self._vel, goals, self.spec.desired_speeds, p)
+        desired = desired_force(self._pos, self._vel, goals, self.spec.desired_speeds, p)
+        f = desired.copy()
         f += social_force(self._pos, self._vel, others_pos, others_vel, np.arange(self.size), p)
+        f0: FloatArray | None = None
+        if without_robot and robot_position is not None:
+            f0 = desired.copy()
+            f0 += social_force(self._pos, self._vel, self._pos, self._vel, np.arange(self.size), p)
+        rest = np.zeros_like(f)
         if p.pysocialforce_compat:
-            f += obstacle_force_samples(self._pos, self._obstacle_samples, p)
+            rest = obstacle_force_samples(self._pos, self._obstacle_samples, p)
         elif not self.world.is_empty:
             signed, nearest = self.world.per_obstacle(self._pos)
-            f += obstacle_force(self._pos, signed, nearest, p)
-        f += group_forces(self._pos, goals, self._group_id, p)
-        return f
+            rest = obstacle_force(self._pos, signed, nearest, p)
+        group = group_forces(self._pos, goals, self._group_id, p)
+        for total in (f, f0):
+            if total is not None:
+                if p.pysocialforce_compat or not self.world.is_empty:
+                    total += rest
+                total += group
+        return f, f0
+
+    @property
+    def undisturbed_velocities(self) -> FloatArray | None:
+        """The velocities (k, 2) the last step would have given the people without the robot, from the same
+        state (the same forces less the robot's repulsion); None before a step with a robot."""
+        return None if self._undisturbed is None else self._undisturbed.copy()
+
+    def _velocities(self, force: FloatArray) -> FloatArray:
+        """The step's velocities from ``force``: capped, zero for people who arrived at a final waypoint."""
+        vel = self._vel + self.params.dt * force
+        direction, speed = normalize(vel)
+        vel = direction * np.minimum(speed, self._max_speed)[:, None]
+        final = ~(self._wp_idx + 1 < self._n_wp) & ~self.spec.loop
+        arrived = final & (np.linalg.norm(self.goals - self._pos, axis=1) < self.params.arrival_radius)
+        vel[arrived] = 0.0
+        return vel
 
     def step(self, robot_position: ArrayLike | None = None, robot_velocity: ArrayLike | None = None) -> None:
         """Advance the crowd by one ``params.dt``; the robot (if given) repels the humans."""
@@ -196,15 +248,11 @@ class Crowd:
             self.time += self.params.dt
             return
         self._advance_waypoints()
-        force = self.forces(robot_position, robot_velocity)
+        force, force0 = self._forces(robot_position, robot_velocity, without_robot=True)
         if not np.all(np.isfinite(force)):
             raise FloatingPointError("social force model produced a non-finite force; check the crowd state")
-        vel = self._vel + self.params.dt * force
-        direction, speed = normalize(vel)
-        vel = direction * np.minimum(speed, self._max_speed)[:, None]
-        final = ~(self._wp_idx + 1 < self._n_wp) & ~self.spec.loop
-        arrived = final & (np.linalg.norm(self.goals - self._pos, axis=1) < self.params.arrival_radius)
-        vel[arrived] = 0.0
+        vel = self._velocities(force)
+        self._undisturbed = None if force0 is None else self._velocities(force0)
         self._pos = self._pos + self.params.dt * vel
         self._vel = vel
         self.time += self.params.dt

@@ -10,6 +10,15 @@ whole episode (so the scene stays busy however long the robot needs). Desired wa
 are drawn from U(0.9, 1.3) m/s around the 1.1-1.3 m/s usually measured for people walking
 indoors; the social force model caps the speed at 1.3 times the desired one (Helbing & Molnár).
 
+**CrowdNav** (``CROWDNAV_SCENARIOS``: ``crowdnav_circle_N`` and ``crowdnav_square_N`` for N = 5, 10 and
+20 people; any seed): CrowdNav's circle and square crossings (Chen et al. 2019): every person walks at
+1 m/s from a random start to their own goal and stays there; the robot crosses from (0, -4) to (0, 4) m
+within 30 s. Short episodes, for campaigns of thousands.
+
+Simulated people move by a crowd model (:data:`CROWD_MODELS`, :meth:`Scenario.start_crowd`): the social
+force model (:mod:`humanmpc.sim.crowd`, the default) or ORCA (:mod:`humanmpc.sim.orca`); the scenario
+fixes where they start and go, the model how they walk there and react to each other and to the robot.
+
 **Recorded** (``RECORDED_SCENARIOS``: ``biwi_eth``, ``biwi_hotel``, ``crowds_zara01``; seeds
 ``0..RECORDED_CROSSINGS - 1``): real pedestrians replayed as recorded, whatever the robot does
 (:mod:`humanmpc.sim.recorded`), in an empty world whose bounds cover every annotated position
@@ -35,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .crowd import Crowd, CrowdSpec, HumanCrowd
+from .orca import OrcaCrowd, OrcaParams
 from .recorded import ANNOTATION_PERIOD, RecordedCrowd, RecordedCrowdSpec, Recording, load_recording
 from .social_force import SocialForceParams
 from .world import Circle, Obstacle, Polygon, World
@@ -42,6 +52,8 @@ from .world import Circle, Obstacle, Polygon, World
 FloatArray = NDArray[np.float64]
 
 V_REF = 0.8  # the robot's preferred cruising speed in every scenario (m/s)
+
+CROWD_MODELS = ("social_force", "orca")  # how simulated people move (recorded people are replayed)
 
 
 @dataclass(frozen=True)
@@ -57,13 +69,24 @@ class Scenario:
     time_limit: float
     goal_tolerance: float = 0.3
 
-    def start_crowd(self, social_force: SocialForceParams | None = None) -> HumanCrowd:
-        """The crowd of a new episode: the social force model run with ``social_force`` (its
-        ``dt`` is the period of a step), or the recorded people replayed at that period."""
+    @property
+    def recorded(self) -> bool:
+        """Whether the people are replayed from a recording (they then ignore the robot and the crowd model)."""
+        return isinstance(self.crowd, RecordedCrowdSpec)
+
+    def start_crowd(self, social_force: SocialForceParams | None = None, model: str = "social_force",
+                    orca: OrcaParams | None = None) -> HumanCrowd:
+        """The crowd of a new episode: the simulated people moved by ``model`` (:data:`CROWD_MODELS`: the
+        social force model run with ``social_force``, whose ``dt`` is the period of a step, or ORCA with
+        ``orca``), or the recorded people replayed at that period whatever the model."""
         params = social_force or SocialForceParams()
         if isinstance(self.crowd, RecordedCrowdSpec):
             return RecordedCrowd(self.crowd, params.dt)
-        return Crowd(self.crowd, self.world, params)
+        if model == "social_force":
+            return Crowd(self.crowd, self.world, params)
+        if model == "orca":
+            return OrcaCrowd(self.crowd, self.world, orca or OrcaParams(dt=params.dt))
+        raise ValueError(f"unknown crowd model {model!r}; crowd models: {', '.join(CROWD_MODELS)}")
 
 
 def _heading(a: FloatArray, b: FloatArray) -> float:
@@ -210,6 +233,73 @@ def corridor(seed: int) -> Scenario:
     return Scenario("corridor", seed, world, crowd, x0, goal, time_limit=60.0)
 
 
+# CrowdNav's scenes (Chen et al. 2019, crowd_sim): people placed at random, each walking at 1 m/s to their
+# own goal and stopping there; the robot crosses from (0, -4) to (0, 4). In 5, 10 and 20 people.
+CROWDNAV_SIZES = (5, 10, 20)
+CROWDNAV_RADIUS = 4.0  # m: the circle of the circle crossing (and the robot's start and goal distance)
+CROWDNAV_SQUARE = 10.0  # m: the square of the square crossing
+CROWDNAV_SPEED = 1.0  # m/s: every person's desired speed (CrowdNav's v_pref)
+CROWDNAV_GAP = 0.7  # m between two people's starts, and two goals: 2 x 0.25 m radius + CrowdNav's 0.2 m discomfort
+CROWDNAV_ROBOT_GAP = 1.2  # m between a person's start or goal and the robot's start or goal
+CROWDNAV_TIME_LIMIT = 30.0  # s (CrowdNav: 25 s at 1 m/s; the robot cruises at 0.8 m/s here)
+
+
+def _crowdnav_place(draw: Callable[[], FloatArray], taken: list[FloatArray], robot: list[FloatArray]) -> FloatArray:
+    for _ in range(10_000):
+        p = draw()
+        if all(np.linalg.norm(p - q) >= CROWDNAV_GAP for q in taken) and \
+                all(np.linalg.norm(p - q) >= CROWDNAV_ROBOT_GAP for q in robot):
+            return p
+    raise RuntimeError("CrowdNav scenario: no free place left for a person after 10,000 draws")
+
+
+def _crowdnav_scenario(name: str, seed: int, starts: list[FloatArray], goals: list[FloatArray],
+                       half: float) -> Scenario:
+    pos = np.array(starts).reshape(-1, 2)
+    crowd = CrowdSpec.build(pos, [g[None] for g in goals], CROWDNAV_SPEED)  # at rest, a final goal each
+    x0, goal = _robot(np.array([0.0, -CROWDNAV_RADIUS]), np.array([0.0, CROWDNAV_RADIUS]))
+    return Scenario(name, seed, World((), (-half, half, -half, half)), crowd, x0, goal,
+                    time_limit=CROWDNAV_TIME_LIMIT)
+
+
+def crowdnav_circle(people: int, seed: int) -> Scenario:
+    """CrowdNav's circle crossing: ``people`` start on a circle of radius 4 m (each coordinate moved by
+    U(-0.5, 0.5) m) and walk to the antipode of their start; starts at least 0.7 m from every other
+    person's start and goal, 1.2 m from the robot's start and goal."""
+    rng = np.random.default_rng(seed)
+    robot = [np.array([0.0, -CROWDNAV_RADIUS]), np.array([0.0, CROWDNAV_RADIUS])]
+    starts: list[FloatArray] = []
+
+    def draw() -> FloatArray:
+        angle = rng.uniform(0.0, 2 * np.pi)
+        noise = rng.uniform(-0.5, 0.5, 2) * CROWDNAV_SPEED
+        return CROWDNAV_RADIUS * np.array([np.cos(angle), np.sin(angle)]) + noise
+
+    for _ in range(people):
+        starts.append(_crowdnav_place(draw, [*starts, *(-q for q in starts)], robot))
+    return _crowdnav_scenario(f"crowdnav_circle_{people}", seed, starts, [-q for q in starts],
+                              CROWDNAV_RADIUS + 2.0)
+
+
+def crowdnav_square(people: int, seed: int) -> Scenario:
+    """CrowdNav's square crossing: each of ``people`` starts at random in one half of a 10 m square (left
+    or right, at even odds) and walks to a random point of the other half; starts at least 0.7 m apart,
+    goals too, both 1.2 m from the robot's start and goal."""
+    rng = np.random.default_rng(seed)
+    robot = [np.array([0.0, -CROWDNAV_RADIUS]), np.array([0.0, CROWDNAV_RADIUS])]
+    w = CROWDNAV_SQUARE
+    starts: list[FloatArray] = []
+    goals: list[FloatArray] = []
+    def in_half(side: float) -> Callable[[], FloatArray]:
+        return lambda: np.array([rng.uniform() * w * 0.5 * side, (rng.uniform() - 0.5) * w])
+
+    for _ in range(people):
+        sign = -1.0 if rng.uniform() > 0.5 else 1.0
+        starts.append(_crowdnav_place(in_half(sign), starts, robot))
+        goals.append(_crowdnav_place(in_half(-sign), goals, robot))
+    return _crowdnav_scenario(f"crowdnav_square_{people}", seed, starts, goals, w / 2 + 1.0)
+
+
 RECORDED_CROSSINGS = 8  # per recorded scene: 4 start times x 2 directions
 RECORDED_TIME_LIMIT = 60.0  # s
 _START_TIMES = RECORDED_CROSSINGS // 2
@@ -290,6 +380,7 @@ def recorded_scene(name: str, seed: int) -> Scenario:
 
 
 SIMULATED_SCENARIOS = ("circle_crossing", "corridor", "crossing_group", "random_crowded_cluttered")
+CROWDNAV_SCENARIOS = tuple(f"crowdnav_{kind}_{n}" for kind in ("circle", "square") for n in CROWDNAV_SIZES)
 RECORDED_SCENARIOS = ("biwi_eth", "biwi_hotel", "crowds_zara01")
 
 SCENARIOS: dict[str, Callable[[int], Scenario]] = {
@@ -297,6 +388,8 @@ SCENARIOS: dict[str, Callable[[int], Scenario]] = {
     "crossing_group": crossing_group,
     "circle_crossing": circle_crossing,
     "corridor": corridor,
+    **{f"crowdnav_circle_{n}": functools.partial(crowdnav_circle, n) for n in CROWDNAV_SIZES},
+    **{f"crowdnav_square_{n}": functools.partial(crowdnav_square, n) for n in CROWDNAV_SIZES},
     **{name: functools.partial(recorded_scene, name) for name in RECORDED_SCENARIOS},
 }
 
