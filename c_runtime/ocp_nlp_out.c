@@ -15,15 +15,12 @@
  * NLP's linearised here), soft rows carrying the slack they need at this point. */
 HM_FUNC void ocp_nlp_residuals(hm_solver *s, hm_output *out)
 {
-    hm_ocp_qp *qp = &s->qp;
-    hm_ocp_qp_sol *m = &s->mult;
+    const hm_ocp_qp *qp = &s->qp;
+    const hm_ocp_qp_sol *m = &s->mult;
     hm_ocp_qp_res res;
     hm_real gap = HM_R(0.0);
-    int n, j, i;
+    int i;
     for (i = 0; i < HM_NX; i++) gap = hm_fmax(gap, hm_fabs(qp->x0[i]));
-    for (n = 0; n <= HM_N; n++)
-        for (j = 0; j < HM_NG; j++)
-            m->s[n][j] = (j < qp->ng[n] && qp->lg[n][j] > HM_R(0.0)) ? qp->lg[n][j] : HM_R(0.0);
     ocp_qp_res_at_zero_step(qp, m, &res);
     out->kkt_stat = res.stat;
     out->kkt_eq = hm_fmax(res.eq, gap);

@@ -63,7 +63,7 @@ static int ocp_nlp_admit_violated_rows(hm_solver *s, hm_real tol)
     hm_ocp_qp *qp = &s->qp;
     int n, j, added = 0;
     for (n = 1; n <= HM_N; n++) {
-        const hm_real dp0 = s->qp_sol.x[n][0], dp1 = s->qp_sol.x[n][1];
+        const hm_real dp0 = s->mult.x[n][0], dp1 = s->mult.x[n][1];
         for (j = 0; j < qp->ng[n]; j++) {
             const hm_real lg = s->screened_lg[n][j];
             if (s->screened[n][j]
@@ -102,7 +102,7 @@ static void ocp_nlp_size_screening(hm_solver *s)
 {
     hm_real d2[HM_N + 2];
     int n;
-    for (n = 0; n <= HM_N; n++) d2[n] = s->qp_sol.x[n][0] * s->qp_sol.x[n][0] + s->qp_sol.x[n][1] * s->qp_sol.x[n][1];
+    for (n = 0; n <= HM_N; n++) d2[n] = s->mult.x[n][0] * s->mult.x[n][0] + s->mult.x[n][1] * s->mult.x[n][1];
     d2[HM_N + 1] = d2[HM_N];
     for (n = 0; n <= HM_N; n++)
         s->screen_radius[n] = OCP_NLP_SCREEN_MIN + HM_R(2.0) * hm_sqrt(hm_fmax(d2[n], d2[n + 1]));
@@ -122,7 +122,7 @@ HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int shift
     if (screen) ocp_nlp_screen_rows(s);
     for (round = 0;; round++) {
         s->ipm_arg.warm_start = round > 0 ? 2 : shifted;
-        status = ocp_qp_ipm_solve(&s->qp, &s->qp_sol, &s->ipm_ws, &s->ipm_arg);
+        status = ocp_qp_ipm_solve(&s->qp, &s->mult, &s->ipm_ws, &s->ipm_arg);
         *qp_iter += s->ipm_ws.out.iter;
         s->qp_solves++;
         if (!screen || !ocp_nlp_qp_usable(status)) break;
@@ -133,7 +133,7 @@ HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int shift
         }
         if (round > OCP_NLP_SCREEN_ROUNDS || ocp_nlp_admit_violated_rows(s, tol) == 0) break;
     }
-    if (screen) ocp_nlp_unscreen_rows(s, &s->qp_sol);
+    if (screen) ocp_nlp_unscreen_rows(s, &s->mult);
     if (ocp_nlp_qp_usable(status)) ocp_nlp_size_screening(s);
     return status;
 }

@@ -10,7 +10,10 @@ typedef unsigned long long (*HM_NS(clock_fn))(void *ctx); /* monotonic time in n
 
 typedef struct HM_NS(solver) {
     HM_NS(params) params;
-    /* The iterate (linearisation point) and the multipliers of the last QP. */
+    /* The iterate (linearisation point), and the last QP's solution: its step (x, u: applied in the
+     * step that solved it) and its multipliers, which are the NLP's (the residuals' and, shifted, the
+     * next linearisation's). One struct for both: the QP writes its solution where the NLP keeps its
+     * multipliers (after a failed QP they are that QP's last iterate's, and the next step starts cold). */
     HM_REAL x[HM_N + 1][HM_NX];
     HM_REAL u[HM_N][HM_NU];
     HM_NS(ocp_qp_sol) mult;
@@ -31,7 +34,6 @@ typedef struct HM_NS(solver) {
     unsigned char screened[HM_N + 1][HM_NG];
     /* The QP of the current linearisation and its solver. */
     HM_NS(ocp_qp) qp;
-    HM_NS(ocp_qp_sol) qp_sol;
     HM_NS(ocp_qp_ipm_arg) ipm_arg;
     HM_NS(ocp_qp_ipm_ws) ipm_ws;
     /* The linearisation point during a line search (full SQP). */

@@ -127,13 +127,21 @@ HM_FUNC int ocp_qp_ipm_finish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
     } else {
         ocp_qp_ipm_write_sol(qp, ws, sol, HM_R(1.0) / ws->cost_scale, HM_R(1.0));
     }
+#ifdef HM_QP_POLISH
     polish = status == HM_QP_SOLVED && (polish == 1 || (polish == 2 && ocp_qp_ipm_undecided(ws, alpha)));
+#else
+    /* built without the polish (ocp_qp_ipm_types.h: HM_QP_POLISH): arg->polish has no effect */
+    polish = 0;
+    (void)alpha;
+#endif
     if (residuals || polish || status != HM_QP_SOLVED) {
         ocp_qp_res_compute(qp, sol, &ws->out.res);
     } else {
         ws->out.res.stat = ws->out.res.eq = ws->out.res.ineq = ws->out.res.comp = ws->out.res.dual = ws->out.res.obj = HM_R(0.0);
     }
+#ifdef HM_QP_POLISH
     if (polish) ocp_qp_ipm_polish(qp, sol, ws, alpha);
+#endif
     ws->out.status = status;
     return status;
 }
@@ -193,6 +201,7 @@ HM_FUNC int ocp_qp_ipm_run(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ip
         ws->out.status = status;
         return status;
     }
+    if (status) return ocp_qp_ipm_finish(qp, sol, ws, status, HM_R(0.0), 0, 0, 1, HM_R(0.0));
 
     if (warm) ocp_qp_ipm_warm_apply(ws, arg->warm_start == 1);
     for (;;) {
@@ -287,8 +296,7 @@ HM_FUNC int ocp_qp_ipm_run(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ip
         }
         if (ws->out.iter > 0 && alpha < HM_R(0.5)) {
             hm_real bwr;
-            ocp_qp_ipm_ray_from_step(ws);
-            if (ocp_qp_ipm_farkas(qp, ws, &ws->u.f.va, arg->tol_infeas, &bwr)) {
+            if (ocp_qp_ipm_farkas_step(qp, ws, arg->tol_infeas, &bwr)) {
                 status = HM_QP_INFEASIBLE;
                 ray = 1;
                 sm.bw = bwr;
@@ -413,7 +421,7 @@ HM_FUNC int ocp_qp_ipm_run(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ip
         return status;
     }
     if (ray) {
-        ocp_qp_ipm_write_sol_vec(qp, ws, &ws->u.f.va, sol, HM_R(1.0) / -sm.bw);
+        ocp_qp_ipm_write_sol_ray(qp, ws, sol, HM_R(1.0) / -sm.bw);
         ocp_qp_res_compute(qp, sol, &ws->out.res);
         ws->out.status = status;
         return status;

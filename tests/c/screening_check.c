@@ -75,7 +75,7 @@ int main(int argc, char **argv)
             arg.should_stop = 0;
             arg.residuals = 1;
             ocp_qp_ipm_solve(&qp_full, &sol_full, &ws_full, &arg);
-            ocp_qp_res_compute(&solver.qp, &solver.qp_sol, &r_scr);
+            ocp_qp_res_compute(&solver.qp, &solver.mult, &r_scr);
             r_full = ws_full.out.res;
             {
                 const double dobj = fabs(r_scr.obj - r_full.obj) / fmax(1.0, fabs(r_full.obj));
