@@ -83,7 +83,8 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
     ocp_nlp_clear_output(out);
     s->qp_solves = 0;
     out->sqp_iterations = 1;
-    reason = ocp_nlp_check_before(s, in);
+    /* a whole step: its preparation, just now, checked the same input (s->prepared: it passed) */
+    reason = ocp_nlp_check_before(s, in, !separate && s->prepared);
     if (reason == HM_STOP_NONE) {
         if (!s->prepared) {
             ocp_nlp_rti_prepare(s, in);

@@ -67,7 +67,7 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
     int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER, reason, late = 0;
     ocp_nlp_clear_output(out);
     s->qp_solves = 0;
-    reason = ocp_nlp_check_before(s, in);
+    reason = ocp_nlp_check_before(s, in, 0);
     if (reason == HM_STOP_NONE && (max_iter < 1 || !(tol > HM_R(0.0) && tol < HM_INF)))
         reason = HM_STOP_INVALID_INPUT;
     if (reason != HM_STOP_NONE) {
