@@ -105,7 +105,7 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
             s->merit_mu = HM_R(1.0);
             qp_status = ocp_nlp_qp_line_search_step(s, in, s->params.qp_tol, shifted, &out->qp_iterations);
         } else {
-            qp_status = ocp_nlp_qp_step(s, shifted, &out->qp_iterations);
+            qp_status = ocp_nlp_qp_step(s, in, shifted, &out->qp_iterations);
         }
         s->ipm_arg.should_stop = 0;
         s->ipm_arg.stop_ctx = 0;
@@ -132,7 +132,7 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
                 ocp_nlp_set_x0(s, in);
                 s->ipm_arg.should_stop = ocp_nlp_deadline_passed;
                 s->ipm_arg.stop_ctx = s;
-                qp_status = ocp_nlp_qp_step(s, 0, &out->qp_iterations);
+                qp_status = ocp_nlp_qp_step(s, in, 0, &out->qp_iterations);
                 s->ipm_arg.should_stop = 0;
                 s->ipm_arg.stop_ctx = 0;
                 ocp_nlp_residuals(s, out);

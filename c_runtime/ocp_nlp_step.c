@@ -31,9 +31,9 @@ static void ocp_nlp_save_base(hm_solver *s)
 }
 
 /* Solve the QP; when usable, take the full step (real-time iteration). */
-HM_FUNC int ocp_nlp_qp_step(hm_solver *s, int shifted, int *qp_iter)
+HM_FUNC int ocp_nlp_qp_step(hm_solver *s, const hm_input *in, int shifted, int *qp_iter)
 {
-    const int status = ocp_nlp_qp_solve(s, s->params.qp_tol, 0, shifted, qp_iter);
+    const int status = ocp_nlp_qp_solve(s, in, s->params.qp_tol, 0, shifted, qp_iter);
     if (!ocp_nlp_qp_usable(status)) return status;
     ocp_nlp_save_base(s);
     ocp_nlp_step_from_base(s, HM_R(1.0));
@@ -48,6 +48,7 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
     const hm_params *p = &s->params;
     const int nh = ocp_nlp_clamp_humans(in);
     const int ng = nh + (in->has_obstacle ? 1 : 0);
+    const hm_real reach2 = ocp_nlp_collision_reach2(p);
     hm_real merit = HM_R(0.0), gaps = HM_R(0.0);
     int n, i, j;
     for (i = 0; i < HM_NX; i++) gaps += hm_fabs(s->x[0][i] - in->x0[i]);
@@ -65,6 +66,7 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
         merit += l;
         for (j = 0; j < nh; j++) {
             hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP];
+            if (!ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;   /* as the linearisation */
             hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
             merit += f;
         }
@@ -87,7 +89,7 @@ HM_FUNC int ocp_nlp_qp_line_search_step(hm_solver *s, const hm_input *in, hm_rea
                                        int *qp_iter)
 {
     /* The QP must be solved at least as tightly as the SQP is asked to converge. */
-    const int status = ocp_nlp_qp_solve(s, hm_fmin(s->params.qp_tol, HM_R(0.1) * tol), 1, shifted, qp_iter);
+    const int status = ocp_nlp_qp_solve(s, in, hm_fmin(s->params.qp_tol, HM_R(0.1) * tol), 1, shifted, qp_iter);
     hm_real gaps = HM_R(0.0), pi_max = HM_R(0.0), merit0, predicted, alpha = HM_R(1.0);
     int n, i;
     if (!ocp_nlp_qp_usable(status)) return status;
