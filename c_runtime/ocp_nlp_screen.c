@@ -151,19 +151,31 @@ static void ocp_nlp_size_screening(hm_solver *s)
 /* Solve the QP of the current linearisation (its x0 offset set), screened; residuals: the caller
  * reads ipm_ws.out.res. shifted: the QP is the last one's a stage on (the real-time iteration's
  * plan, shifted), and starts from the iterate that the last one kept (ocp_qp_ipm_warm.c);
- * the re-solves with more rows start from the first round's. Returns the QP status. */
+ * the re-solves with more rows start from the first round's. Each solve may take qp_max_iter
+ * interior-point iterations, or (s->qp_budget >= 0, the real-time iteration) what is left of the
+ * step's budget; an exhausted budget ends the solve at HM_QP_MAX_ITER. Returns the QP status. */
 HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, const hm_input *in, hm_real tol, int residuals, int shifted, int *qp_iter)
 {
     const int screen = s->params.row_screening && s->screen_radius[0] < HM_INF;
-    int status, round;
-    s->ipm_arg.max_iter = s->params.qp_max_iter;
+    int status = HM_QP_MAX_ITER, round;
     s->ipm_arg.tol = tol;
     s->ipm_arg.residuals = residuals;
     if (screen) ocp_nlp_screen_rows(s);
     for (round = 0;; round++) {
+        s->ipm_arg.max_iter = s->params.qp_max_iter;
+        if (s->qp_budget >= 0) {
+            /* the real-time iteration's budget: its QP solves share 2 qp_max_iter iterations */
+            if (s->qp_budget < 1) {
+                if (round == 0) ocp_qp_sol_set_zero(&s->mult);   /* nothing solved: a zero step */
+                status = HM_QP_MAX_ITER;
+                break;
+            }
+            if (s->qp_budget < s->ipm_arg.max_iter) s->ipm_arg.max_iter = s->qp_budget;
+        }
         s->ipm_arg.warm_start = round > 0 ? 2 : shifted;
         status = ocp_qp_ipm_solve(&s->qp, &s->mult, &s->ipm_ws, &s->ipm_arg);
         *qp_iter += s->ipm_ws.out.iter;
+        if (s->qp_budget >= 0) s->qp_budget -= s->ipm_ws.out.iter;
         s->qp_solves++;
         if (!screen || !ocp_nlp_qp_usable(status)) break;
         if (round == OCP_NLP_SCREEN_ROUNDS) {

@@ -30,6 +30,9 @@ typedef struct HM_NS(solver) {
      * n - 1 (ocp_nlp_lin.c); node 1's from the measured state, at feedback. */
     HM_REAL v_separation[HM_N + 1];
     int qp_solves;   /* QPs solved in the current step */
+    int qp_budget;   /* interior-point iterations left to the real-time iteration's QP solves in this step
+                        (2 qp_max_iter at its start: its re-solves and braking retry share them, which bounds
+                        the work of a step); < 0: each QP may take qp_max_iter (the full SQP) */
     HM_REAL screened_lg[HM_N + 1][HM_NG];
     unsigned char screened[HM_N + 1][HM_NG];
     /* The QP of the current linearisation and its solver. */
