@@ -12,7 +12,10 @@ typedef HM_NS(ocp_qp_ipm_arg) hm_ocp_qp_ipm_arg;
 typedef HM_NS(ocp_qp_ipm_stage) hm_ocp_qp_ipm_stage;
 typedef HM_NS(ocp_qp_ipm_bounds) hm_ocp_qp_ipm_bounds;
 typedef HM_NS(ocp_qp_ipm_rows) hm_ocp_qp_ipm_rows;
+#ifdef HM_QP_POLISH
 typedef HM_NS(ocp_qp_ipm_vec) hm_ocp_qp_ipm_vec;
+typedef HM_NS(ocp_qp_ipm_general) hm_ocp_qp_ipm_general;
+#endif
 typedef HM_NS(ocp_qp_ipm_ws) hm_ocp_qp_ipm_ws;
 typedef HM_NS(ocp_qp_ipm_warm) hm_ocp_qp_ipm_warm;
 typedef HM_NS(ocp_qp_hsde_vec) hm_ocp_qp_hsde_vec;

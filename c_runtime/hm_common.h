@@ -21,6 +21,12 @@
 #define HM_NU 2
 #define HM_NP 2
 
+/* What the OCP's QPs have (ocp_nlp_lin.c), which sizes a generated solver's QP memory
+ * (ocp_qp_ipm_types.h: HM_NBP, HM_NGH): bounds on three components of (u, x), a and omega (u) and
+ * v (x); no hard rows, every distance row is soft (an exact penalty). */
+#define HM_OCP_NBP 3
+#define HM_OCP_NGH 0
+
 /* Runtime functions are private to the translation unit that includes them. A solver need not use
  * every helper of the runtime, so unused ones must not warn. */
 #ifndef HM_FUNC

@@ -108,8 +108,13 @@ HM_FUNC hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2)
 }
 
 /* Symmetric n x n M (column-major, n <= 6) replaced by its projection onto {eigenvalues >= floor}:
- * cyclic Jacobi rotations, then V max(Lambda, floor) V'. */
-static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
+ * cyclic Jacobi rotations, then V max(Lambda, floor) V'. When M is block diagonal, rows and columns
+ * [0, nb) and [nb, n) (nb = n when it is not), the rotations and products are those of the blocks
+ * alone: a rotation of a pair within one block leaves the other block's entries of its two rows and
+ * columns at exactly +0 (c * 0 - s * 0, s * 0 + c * 0), so the pairs across blocks are skipped by the
+ * full sweep's own test (m_ij == 0) and the products with those zeros change no sum. The same
+ * numbers, in about half the instructions for the robot's stages (ocp_nlp_convexify_stage). */
+static void ocp_nlp_project_psd(hm_real *M, int n, int nb, hm_real floor)
 {
     hm_real V[36], off, total = HM_R(0.0);
     int i, j, k, sweep;
@@ -124,7 +129,9 @@ static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
             for (j = i + 1; j < n; j++) off += M[i + j * n] * M[i + j * n];
         if (off <= HM_EPS * HM_EPS * total) break;
         for (i = 0; i < n; i++) {
-            for (j = i + 1; j < n; j++) {
+            /* the block of row i: its pairs, and the rows and columns a rotation of them touches */
+            const int lo = i < nb ? 0 : nb, hi = i < nb ? nb : n;
+            for (j = i + 1; j < hi; j++) {
                 const hm_real mij = M[i + j * n];
                 hm_real theta, t, c, sn;
                 if (mij == HM_R(0.0)) continue;
@@ -132,17 +139,17 @@ static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
                 t = (theta >= HM_R(0.0) ? HM_R(1.0) : HM_R(-1.0)) / (hm_fabs(theta) + hm_sqrt(theta * theta + HM_R(1.0)));
                 c = HM_R(1.0) / hm_sqrt(t * t + HM_R(1.0));
                 sn = t * c;
-                for (k = 0; k < n; k++) { /* M <- M J */
+                for (k = lo; k < hi; k++) { /* M <- M J */
                     const hm_real a = M[k + i * n], b = M[k + j * n];
                     M[k + i * n] = c * a - sn * b;
                     M[k + j * n] = sn * a + c * b;
                 }
-                for (k = 0; k < n; k++) { /* M <- J' M */
+                for (k = lo; k < hi; k++) { /* M <- J' M */
                     const hm_real a = M[i + k * n], b = M[j + k * n];
                     M[i + k * n] = c * a - sn * b;
                     M[j + k * n] = sn * a + c * b;
                 }
-                for (k = 0; k < n; k++) { /* V <- V J */
+                for (k = lo; k < hi; k++) { /* V <- V J */
                     const hm_real a = V[k + i * n], b = V[k + j * n];
                     V[k + i * n] = c * a - sn * b;
                     V[k + j * n] = sn * a + c * b;
@@ -154,9 +161,11 @@ static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
         hm_real lam[6];
         for (k = 0; k < n; k++) lam[k] = hm_fmax(M[k + k * n], floor);
         for (i = 0; i < n; i++) {
+            const int lo = i < nb ? 0 : nb, hi = i < nb ? nb : n;
             for (j = 0; j < n; j++) {
                 hm_real acc = HM_R(0.0);
-                for (k = 0; k < n; k++) acc += V[i + k * n] * lam[k] * V[j + k * n];
+                if (j >= lo && j < hi)
+                    for (k = lo; k < hi; k++) acc += V[i + k * n] * lam[k] * V[j + k * n];
                 M[i + j * n] = acc;
             }
         }
@@ -168,7 +177,7 @@ static void ocp_nlp_convexify_stage(hm_ocp_qp *qp, int n, hm_real floor)
 {
     hm_real M[36];
     const int nz = n < HM_N ? HM_NX + HM_NU : HM_NX;
-    int i, j;
+    int i, j, nb = 2;
     for (j = 0; j < HM_NX; j++)
         for (i = 0; i < HM_NX; i++) M[i + j * nz] = qp->Q[n][i + j * HM_NX];
     if (n < HM_N) {
@@ -180,7 +189,12 @@ static void ocp_nlp_convexify_stage(hm_ocp_qp *qp, int n, hm_real floor)
         for (j = 0; j < HM_NU; j++)
             for (i = 0; i < HM_NU; i++) M[HM_NX + i + (HM_NX + j) * nz] = qp->R[n][i + j * HM_NU];
     }
-    ocp_nlp_project_psd(M, nz, floor);
+    /* the robot's stages are block diagonal, (px, py) apart from (theta, v, a, omega): the dynamics'
+     * Hessian has no position in it. Checked; the full matrix otherwise. */
+    for (j = 0; j < 2; j++)
+        for (i = 2; i < nz; i++)
+            if (M[i + j * nz] != HM_R(0.0) || M[j + i * nz] != HM_R(0.0)) nb = nz;
+    ocp_nlp_project_psd(M, nz, nb, floor);
     for (j = 0; j < HM_NX; j++)
         for (i = 0; i < HM_NX; i++) qp->Q[n][i + j * HM_NX] = M[i + j * nz];
     if (n < HM_N) {
@@ -202,6 +216,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
     const int nh = ocp_nlp_clamp_humans(in);
     const int ng = nh + (in->has_obstacle ? 1 : 0);
     const hm_real reg = p->regularization;
+    const hm_real reach2 = ocp_nlp_collision_reach2(p);
     hm_real cost = HM_R(0.0), penalty = HM_R(0.0);
     int n, i, j;
 
@@ -241,11 +256,12 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
         for (i = 0; i < HM_NX; i++) Q[i + i * HM_NX] += reg;
         cost += l;
 
-        /* Collision cost of each present human at its predicted position at this node: exact
-         * gradient, Gauss-Newton Hessian on the (px, py) block. */
+        /* Collision cost of each present human within its reach at its predicted position at this
+         * node: exact gradient, Gauss-Newton Hessian on the (px, py) block. */
         for (j = 0; j < nh; j++) {
             hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP], hess_exact[HM_NP * HM_NP];
             const hm_real *hess = hess_gn;
+            if (!ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;
             if (exact) {
                 hm_model_cost_collision(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn,
                                         hess_exact);
@@ -284,6 +300,17 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
             const hm_real l1 = human ? p->human_slack_l1 : p->slack_l1;
             const hm_real l2 = human ? p->human_slack_l2 : p->slack_l2;
             hm_real g, hess_d[HM_NP * HM_NP];
+            qp->soft[n][j] = 1;
+            qp->zl[n][j] = l1;
+            qp->Zl[n][j] = l2;
+            /* beyond the screening radius by plain distance already: screened whatever its exact
+             * margin, and not evaluated unless the QP's step could reach it (ocp_nlp_screen.c); with
+             * the exact Hessian only without a multiplier, whose curvature it would carry */
+            if ((!exact || s->mult.lam_lg[n][j] == HM_R(0.0)) && ocp_nlp_screen_far(s, n, x, c, *d_min)) {
+                qp->D[n][j][0] = qp->D[n][j][1] = HM_R(0.0);
+                qp->lg[n][j] = -HM_INF;
+                continue;
+            }
             hm_model_distance_constraint(x, c, d_min, &g, qp->D[n][j], hess_d);
             if (exact) {
                 /* L = cost - lam (d - d_min + s): the row's curvature enters with -lam. */
@@ -294,9 +321,6 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
                 Q[HM_NX + 1] -= lam * hess_d[3];
             }
             qp->lg[n][j] = -g;
-            qp->soft[n][j] = 1;
-            qp->zl[n][j] = l1;
-            qp->Zl[n][j] = l2;
             penalty += ocp_nlp_slack_penalty(g, l1, l2);
         }
     }

@@ -15,15 +15,12 @@
  * NLP's linearised here), soft rows carrying the slack they need at this point. */
 HM_FUNC void ocp_nlp_residuals(hm_solver *s, hm_output *out)
 {
-    hm_ocp_qp *qp = &s->qp;
-    hm_ocp_qp_sol *m = &s->mult;
+    const hm_ocp_qp *qp = &s->qp;
+    const hm_ocp_qp_sol *m = &s->mult;
     hm_ocp_qp_res res;
     hm_real gap = HM_R(0.0);
-    int n, j, i;
+    int i;
     for (i = 0; i < HM_NX; i++) gap = hm_fmax(gap, hm_fabs(qp->x0[i]));
-    for (n = 0; n <= HM_N; n++)
-        for (j = 0; j < HM_NG; j++)
-            m->s[n][j] = (j < qp->ng[n] && qp->lg[n][j] > HM_R(0.0)) ? qp->lg[n][j] : HM_R(0.0);
     ocp_qp_res_at_zero_step(qp, m, &res);
     out->kkt_stat = res.stat;
     out->kkt_eq = hm_fmax(res.eq, gap);
@@ -109,14 +106,15 @@ HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output
     } else {
         hm_real A[HM_NX * HM_NX], B[HM_NX * HM_NU];
         hm_real best = HM_INF;
-        int j;
+        int j, humans_ok;
         for (i = 0; i < HM_NX; i++) out->x[0][i] = in->x0[i];
         for (n = 0; n < HM_N; n++) {
             out->u[n][0] = hm_fmin(hm_fmax(-out->x[n][3] / HM_R(HM_DT), a_min), a_max);
             out->u[n][1] = HM_R(0.0);
             hm_model_dynamics(out->x[n], out->u[n], out->x[n + 1], A, B);
         }
-        for (n = 0; n <= HM_N && monitor_check_input(in, 1); n++) {
+        humans_ok = monitor_check_input(in, 1);   /* loop-invariant: once, not at every node */
+        for (n = 0; n <= HM_N && humans_ok; n++) {
             for (j = 0; j < ocp_nlp_clamp_humans(in); j++) {
                 const hm_real dx = out->x[n][0] - in->humans_now[j][0];
                 const hm_real dy = out->x[n][1] - in->humans_now[j][1];
@@ -174,10 +172,12 @@ HM_FUNC void ocp_nlp_clear_output(hm_output *out)
 /* The checks that come before any solving; returns the stop reason or HM_STOP_NONE. A warm solver's
  * measured state must follow the last one (monitor_state_follows): a jump beyond what the bounds allow
  * would have the plan of another place shifted and linearised. */
-HM_FUNC int ocp_nlp_check_before(const hm_solver *s, const hm_input *in)
+HM_FUNC int ocp_nlp_check_before(const hm_solver *s, const hm_input *in, int checked_but_x0)
 {
     if (!monitor_check_params(&s->params)) return HM_STOP_INVALID_PARAMS;
-    if (!monitor_check_input(in, 1)) return HM_STOP_INVALID_INPUT;
+    /* the preparation of this very step checked this very input, all of it but (warm) x0: its
+     * predictions are (N + 1) N_h positions, a tenth of the step's work at N_h = 100 */
+    if (checked_but_x0 ? !monitor_check_state(in->x0) : !monitor_check_input(in, 1)) return HM_STOP_INVALID_INPUT;
     if (monitor_distance_now(in) < s->params.d_h) return HM_STOP_HUMAN_TOO_CLOSE;
     if (s->warm && !monitor_state_follows(&s->params, s->x0_last, in->x0)) return HM_STOP_STATE_JUMP;
     return HM_STOP_NONE;

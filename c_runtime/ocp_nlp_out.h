@@ -23,8 +23,10 @@ HM_FUNC void ocp_nlp_clear_output(hm_output *out);
 /* The plan after the command guard, or the protective stop of reason (see ocp_nlp_out.c). */
 HM_FUNC void ocp_nlp_finish(hm_solver *s, const hm_input *in, hm_output *out, int reason);
 
-/* The checks that come before any solving; returns the stop reason or HM_STOP_NONE. */
-HM_FUNC int ocp_nlp_check_before(const hm_solver *s, const hm_input *in);
+/* The checks that come before any solving; returns the stop reason or HM_STOP_NONE. checked_but_x0:
+ * the input passed monitor_check_input(in, 0) already in this step (its preparation's), only x0 is
+ * checked again. */
+HM_FUNC int ocp_nlp_check_before(const hm_solver *s, const hm_input *in, int checked_but_x0);
 
 /* C1 (a finite plan) and C2 on the plan of s; returns the stop reason or HM_STOP_NONE. */
 HM_FUNC int ocp_nlp_check_plan(const hm_solver *s, const hm_input *in);

@@ -38,6 +38,32 @@ HM_FUNC void ocp_nlp_screen_reach(hm_solver *s)
     for (n = 0; n <= HM_N; n++) s->screen_radius[n] = HM_R(0.5) + vmax * HM_R(HM_DT) * (hm_real)n;
 }
 
+/* 1 when screening is on and the row of the point c (minimum distance d_min) at node n, linearised at
+ * x, is beyond the stage's radius by plain distance already: |x - c| - d_min >= radius. The smooth
+ * distance of the model is at least the plain one, so its margin is too: the row would be screened
+ * (ocp_nlp_screen_rows). Such a row is not evaluated by the linearisation (lg = -HM_INF, D = 0; with
+ * 100 people most of the 5,100 rows of a step): ocp_nlp_admit_violated_rows evaluates it only if the
+ * QP's step moves its node far enough to reach it. */
+HM_FUNC int ocp_nlp_screen_far(const hm_solver *s, int n, const hm_real *x, const hm_real *c, hm_real d_min)
+{
+    const hm_real reach = s->screen_radius[n] + d_min;
+    const hm_real dx = x[0] - c[0], dy = x[1] - c[1];
+    return s->params.row_screening && s->screen_radius[0] < HM_INF && reach > HM_R(0.0)
+           && dx * dx + dy * dy >= reach * reach;
+}
+
+/* The row j of node n evaluated at the linearisation point (a row ocp_nlp_screen_far left out), into
+ * the QP's D and, kept aside as a screened row's, its lg. */
+static void ocp_nlp_evaluate_row(hm_solver *s, const hm_input *in, int n, int j)
+{
+    const hm_params *p = &s->params;
+    const int human = j < ocp_nlp_clamp_humans(in);
+    hm_real g, hess_d[HM_NP * HM_NP];
+    hm_model_distance_constraint(s->x[n], human ? in->humans_now[j] : in->obstacle, human ? &p->d_h : &p->d_s, &g,
+                                 s->qp.D[n][j], hess_d);
+    s->screened_lg[n][j] = -g;
+}
+
 /* Rows with margin -lg = d - d_min not below the stage's radius leave the QP: their lg is kept in
  * screened_lg and made absent (-HM_INF), which the QP solvers skip like any absent bound. Nothing
  * else of the QP moves, so putting a row back is one store. */
@@ -57,15 +83,29 @@ static void ocp_nlp_screen_rows(hm_solver *s)
     }
 }
 
-/* Rows left out that the QP's step violates (by more than tol) join the QP; returns how many. */
-static int ocp_nlp_admit_violated_rows(hm_solver *s, hm_real tol)
+/* Rows left out that the QP's step violates (by more than tol) join the QP; returns how many. A row
+ * the linearisation did not evaluate (lg = -HM_INF) is evaluated first if the step's displacement of
+ * its node reaches it: its linearised margin moves by at most that much (|D| <= 1), from one at least
+ * its plain distance's. */
+static int ocp_nlp_admit_violated_rows(hm_solver *s, const hm_input *in, hm_real tol)
 {
     hm_ocp_qp *qp = &s->qp;
     int n, j, added = 0;
     for (n = 1; n <= HM_N; n++) {
-        const hm_real dp0 = s->qp_sol.x[n][0], dp1 = s->qp_sol.x[n][1];
+        const hm_real dp0 = s->mult.x[n][0], dp1 = s->mult.x[n][1];
+        const hm_real step2 = dp0 * dp0 + dp1 * dp1;
         for (j = 0; j < qp->ng[n]; j++) {
-            const hm_real lg = s->screened_lg[n][j];
+            hm_real lg;
+            if (s->screened[n][j] && s->screened_lg[n][j] == -HM_INF) {
+                const int human = j < ocp_nlp_clamp_humans(in);
+                const hm_real *c = human ? in->humans_now[j] : in->obstacle;
+                const hm_real d_min = human ? s->params.d_h : s->params.d_s;
+                const hm_real dx = s->x[n][0] - c[0], dy = s->x[n][1] - c[1];
+                const hm_real reach = hm_sqrt(step2) + d_min;
+                if (dx * dx + dy * dy > reach * reach) continue;   /* the step cannot reach it */
+                ocp_nlp_evaluate_row(s, in, n, j);
+            }
+            lg = s->screened_lg[n][j];
             if (s->screened[n][j]
                 && qp->D[n][j][0] * dp0 + qp->D[n][j][1] * dp1 < lg - tol * hm_fmax(HM_R(1.0), hm_fabs(lg))) {
                 s->screened[n][j] = 0;
@@ -102,7 +142,7 @@ static void ocp_nlp_size_screening(hm_solver *s)
 {
     hm_real d2[HM_N + 2];
     int n;
-    for (n = 0; n <= HM_N; n++) d2[n] = s->qp_sol.x[n][0] * s->qp_sol.x[n][0] + s->qp_sol.x[n][1] * s->qp_sol.x[n][1];
+    for (n = 0; n <= HM_N; n++) d2[n] = s->mult.x[n][0] * s->mult.x[n][0] + s->mult.x[n][1] * s->mult.x[n][1];
     d2[HM_N + 1] = d2[HM_N];
     for (n = 0; n <= HM_N; n++)
         s->screen_radius[n] = OCP_NLP_SCREEN_MIN + HM_R(2.0) * hm_sqrt(hm_fmax(d2[n], d2[n + 1]));
@@ -111,29 +151,45 @@ static void ocp_nlp_size_screening(hm_solver *s)
 /* Solve the QP of the current linearisation (its x0 offset set), screened; residuals: the caller
  * reads ipm_ws.out.res. shifted: the QP is the last one's a stage on (the real-time iteration's
  * plan, shifted), and starts from the iterate that the last one kept (ocp_qp_ipm_warm.c);
- * the re-solves with more rows start from the first round's. Returns the QP status. */
-HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int shifted, int *qp_iter)
+ * the re-solves with more rows start from the first round's. Each solve may take qp_max_iter
+ * interior-point iterations, or (s->qp_budget >= 0, the real-time iteration) what is left of the
+ * step's budget; an exhausted budget ends the solve at HM_QP_MAX_ITER. Returns the QP status. */
+HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, const hm_input *in, hm_real tol, int residuals, int shifted, int *qp_iter)
 {
     const int screen = s->params.row_screening && s->screen_radius[0] < HM_INF;
-    int status, round;
-    s->ipm_arg.max_iter = s->params.qp_max_iter;
+    int status = HM_QP_MAX_ITER, round;
     s->ipm_arg.tol = tol;
     s->ipm_arg.residuals = residuals;
     if (screen) ocp_nlp_screen_rows(s);
     for (round = 0;; round++) {
+        s->ipm_arg.max_iter = s->params.qp_max_iter;
+        if (s->qp_budget >= 0) {
+            /* the real-time iteration's budget: its QP solves share 2 qp_max_iter iterations */
+            if (s->qp_budget < 1) {
+                if (round == 0) ocp_qp_sol_set_zero(&s->mult);   /* nothing solved: a zero step */
+                status = HM_QP_MAX_ITER;
+                break;
+            }
+            if (s->qp_budget < s->ipm_arg.max_iter) s->ipm_arg.max_iter = s->qp_budget;
+        }
         s->ipm_arg.warm_start = round > 0 ? 2 : shifted;
-        status = ocp_qp_ipm_solve(&s->qp, &s->qp_sol, &s->ipm_ws, &s->ipm_arg);
+        status = ocp_qp_ipm_solve(&s->qp, &s->mult, &s->ipm_ws, &s->ipm_arg);
         *qp_iter += s->ipm_ws.out.iter;
+        if (s->qp_budget >= 0) s->qp_budget -= s->ipm_ws.out.iter;
         s->qp_solves++;
         if (!screen || !ocp_nlp_qp_usable(status)) break;
         if (round == OCP_NLP_SCREEN_ROUNDS) {
-            /* pathological: rows keep turning up; the whole QP settles it */
+            /* pathological: rows keep turning up; the whole QP settles it (every row evaluated) */
+            int n, j;
+            for (n = 1; n <= HM_N; n++)
+                for (j = 0; j < s->qp.ng[n]; j++)
+                    if (s->screened[n][j] && s->screened_lg[n][j] == -HM_INF) ocp_nlp_evaluate_row(s, in, n, j);
             ocp_nlp_unscreen_rows(s, 0);
             continue;
         }
-        if (round > OCP_NLP_SCREEN_ROUNDS || ocp_nlp_admit_violated_rows(s, tol) == 0) break;
+        if (round > OCP_NLP_SCREEN_ROUNDS || ocp_nlp_admit_violated_rows(s, in, tol) == 0) break;
     }
-    if (screen) ocp_nlp_unscreen_rows(s, &s->qp_sol);
+    if (screen) ocp_nlp_unscreen_rows(s, &s->mult);
     if (ocp_nlp_qp_usable(status)) ocp_nlp_size_screening(s);
     return status;
 }

@@ -10,9 +10,13 @@
  * cover by each node, plus the margin. */
 HM_FUNC void ocp_nlp_screen_reach(hm_solver *s);
 
-/* Solve the QP of the current linearisation (its x0 offset set), screened, to tol; residuals: the
+/* Solve the QP of the current linearisation (its x0 offset set; in: its input), screened, to tol; residuals: the
  * solver's residuals of the returned solution (ocp_qp_ipm_arg); shifted: warm start from the iterate
  * the last solve kept, a stage on. Adds the iterations to *qp_iter; returns the QP status. */
-HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, hm_real tol, int residuals, int shifted, int *qp_iter);
+HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, const hm_input *in, hm_real tol, int residuals, int shifted, int *qp_iter);
+
+/* 1 when screening is on and the row of the point c (minimum distance d_min) at node n, linearised at x,
+ * is beyond the stage's screening radius by plain distance: the linearisation leaves it unevaluated. */
+HM_FUNC int ocp_nlp_screen_far(const hm_solver *s, int n, const hm_real *x, const hm_real *c, hm_real d_min);
 
 #endif /* OCP_NLP_SCREEN_H */

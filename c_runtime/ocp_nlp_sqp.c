@@ -44,6 +44,7 @@ HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
     s->prepared = 0;
     s->ipm_ws.warm.ready = 0;
     s->dyn_fresh = 0;
+    s->qp_budget = -1;
     for (n = 0; n < HM_N; n++)
         for (i = 0; i < HM_NU; i++) s->u[n][i] = HM_R(0.0);
     for (n = 0; n <= HM_N; n++)
@@ -67,7 +68,8 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
     int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER, reason, late = 0;
     ocp_nlp_clear_output(out);
     s->qp_solves = 0;
-    reason = ocp_nlp_check_before(s, in);
+    s->qp_budget = -1;   /* each of the SQP's QPs its own qp_max_iter */
+    reason = ocp_nlp_check_before(s, in, 0);
     if (reason == HM_STOP_NONE && (max_iter < 1 || !(tol > HM_R(0.0) && tol < HM_INF)))
         reason = HM_STOP_INVALID_INPUT;
     if (reason != HM_STOP_NONE) {

@@ -1,8 +1,8 @@
 /*
  * ocp_nlp_step.c: the step of an SQP iteration from its QP's solution: the full step (real-time
  * iteration) or a backtracking line search on the l1 merit (full SQP, and the real-time iteration
- * with line_search); the QP's multipliers become the NLP's. The linearisation point is kept in
- * x_base, u_base for the step's duration.
+ * with line_search). The QP's multipliers are the NLP's: the QP writes its solution into s->mult.
+ * The linearisation point is kept in x_base, u_base for the step's duration.
  */
 #include "ocp_nlp_step.h"
 
@@ -13,7 +13,7 @@
 static void ocp_nlp_step_from_base(hm_solver *s, hm_real alpha)
 {
     int n, i;
-    const hm_ocp_qp_sol *d = &s->qp_sol;
+    const hm_ocp_qp_sol *d = &s->mult;
     s->dyn_fresh = 0;
     for (n = 0; n <= HM_N; n++)
         for (i = 0; i < HM_NX; i++) s->x[n][i] = s->x_base[n][i] + alpha * d->x[n][i];
@@ -30,35 +30,13 @@ static void ocp_nlp_save_base(hm_solver *s)
         for (i = 0; i < HM_NU; i++) s->u_base[n][i] = s->u[n][i];
 }
 
-static void ocp_nlp_copy(hm_real *restrict dst, const hm_real *restrict src, int len)
-{
-    int i;
-    for (i = 0; i < len; i++) dst[i] = src[i];
-}
-
-/* The QP's multipliers become the NLP's. Their primal part stays zero (ocp_qp_sol_set_zero at every
- * cold start; never written), the slacks are set by ocp_nlp_residuals: neither is copied. */
-static void ocp_nlp_take_multipliers(hm_solver *s)
-{
-    hm_ocp_qp_sol *m = &s->mult;
-    const hm_ocp_qp_sol *q = &s->qp_sol;
-    ocp_nlp_copy(&m->pi[0][0], &q->pi[0][0], HM_N * HM_NX);
-    ocp_nlp_copy(&m->lam_lbx[0][0], &q->lam_lbx[0][0], (HM_N + 1) * HM_NX);
-    ocp_nlp_copy(&m->lam_ubx[0][0], &q->lam_ubx[0][0], (HM_N + 1) * HM_NX);
-    ocp_nlp_copy(&m->lam_lbu[0][0], &q->lam_lbu[0][0], HM_N * HM_NU);
-    ocp_nlp_copy(&m->lam_ubu[0][0], &q->lam_ubu[0][0], HM_N * HM_NU);
-    ocp_nlp_copy(&m->lam_lg[0][0], &q->lam_lg[0][0], (HM_N + 1) * HM_NG);
-    ocp_nlp_copy(&m->lam_ls[0][0], &q->lam_ls[0][0], (HM_N + 1) * HM_NG);
-}
-
 /* Solve the QP; when usable, take the full step (real-time iteration). */
-HM_FUNC int ocp_nlp_qp_step(hm_solver *s, int shifted, int *qp_iter)
+HM_FUNC int ocp_nlp_qp_step(hm_solver *s, const hm_input *in, int shifted, int *qp_iter)
 {
-    const int status = ocp_nlp_qp_solve(s, s->params.qp_tol, 0, shifted, qp_iter);
+    const int status = ocp_nlp_qp_solve(s, in, s->params.qp_tol, 0, shifted, qp_iter);
     if (!ocp_nlp_qp_usable(status)) return status;
     ocp_nlp_save_base(s);
     ocp_nlp_step_from_base(s, HM_R(1.0));
-    ocp_nlp_take_multipliers(s);
     return status;
 }
 
@@ -70,6 +48,7 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
     const hm_params *p = &s->params;
     const int nh = ocp_nlp_clamp_humans(in);
     const int ng = nh + (in->has_obstacle ? 1 : 0);
+    const hm_real reach2 = ocp_nlp_collision_reach2(p);
     hm_real merit = HM_R(0.0), gaps = HM_R(0.0);
     int n, i, j;
     for (i = 0; i < HM_NX; i++) gaps += hm_fabs(s->x[0][i] - in->x0[i]);
@@ -87,6 +66,7 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
         merit += l;
         for (j = 0; j < nh; j++) {
             hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP];
+            if (!ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;   /* as the linearisation */
             hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
             merit += f;
         }
@@ -109,7 +89,7 @@ HM_FUNC int ocp_nlp_qp_line_search_step(hm_solver *s, const hm_input *in, hm_rea
                                        int *qp_iter)
 {
     /* The QP must be solved at least as tightly as the SQP is asked to converge. */
-    const int status = ocp_nlp_qp_solve(s, hm_fmin(s->params.qp_tol, HM_R(0.1) * tol), 1, shifted, qp_iter);
+    const int status = ocp_nlp_qp_solve(s, in, hm_fmin(s->params.qp_tol, HM_R(0.1) * tol), 1, shifted, qp_iter);
     hm_real gaps = HM_R(0.0), pi_max = HM_R(0.0), merit0, predicted, alpha = HM_R(1.0);
     int n, i;
     if (!ocp_nlp_qp_usable(status)) return status;
@@ -117,7 +97,7 @@ HM_FUNC int ocp_nlp_qp_line_search_step(hm_solver *s, const hm_input *in, hm_rea
     for (n = 0; n < HM_N; n++) {
         for (i = 0; i < HM_NX; i++) {
             gaps += hm_fabs(s->qp.b[n][i]);
-            pi_max = hm_fmax(pi_max, hm_fabs(s->qp_sol.pi[n][i]));
+            pi_max = hm_fmax(pi_max, hm_fabs(s->mult.pi[n][i]));
         }
     }
     s->merit_mu = hm_fmax(s->merit_mu, HM_R(2.0) * pi_max + HM_R(1.0));
@@ -133,6 +113,5 @@ HM_FUNC int ocp_nlp_qp_line_search_step(hm_solver *s, const hm_input *in, hm_rea
             break;
         alpha *= HM_R(0.5);
     }
-    ocp_nlp_take_multipliers(s);
     return status;
 }

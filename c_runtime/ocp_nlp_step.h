@@ -7,7 +7,7 @@
 #include "ocp_nlp_common.h"
 
 /* Solve the QP (ocp_nlp_qp_solve); when usable, take the full step (real-time iteration). */
-HM_FUNC int ocp_nlp_qp_step(hm_solver *s, int shifted, int *qp_iter);
+HM_FUNC int ocp_nlp_qp_step(hm_solver *s, const hm_input *in, int shifted, int *qp_iter);
 
 /* Solve the QP to a tolerance below tol; when usable, a step with a backtracking line search on the
  * l1 merit. */

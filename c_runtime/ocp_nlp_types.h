@@ -10,7 +10,10 @@ typedef unsigned long long (*HM_NS(clock_fn))(void *ctx); /* monotonic time in n
 
 typedef struct HM_NS(solver) {
     HM_NS(params) params;
-    /* The iterate (linearisation point) and the multipliers of the last QP. */
+    /* The iterate (linearisation point), and the last QP's solution: its step (x, u: applied in the
+     * step that solved it) and its multipliers, which are the NLP's (the residuals' and, shifted, the
+     * next linearisation's). One struct for both: the QP writes its solution where the NLP keeps its
+     * multipliers (after a failed QP they are that QP's last iterate's, and the next step starts cold). */
     HM_REAL x[HM_N + 1][HM_NX];
     HM_REAL u[HM_N][HM_NU];
     HM_NS(ocp_qp_sol) mult;
@@ -27,11 +30,13 @@ typedef struct HM_NS(solver) {
      * n - 1 (ocp_nlp_lin.c); node 1's from the measured state, at feedback. */
     HM_REAL v_separation[HM_N + 1];
     int qp_solves;   /* QPs solved in the current step */
+    int qp_budget;   /* interior-point iterations left to the real-time iteration's QP solves in this step
+                        (2 qp_max_iter at its start: its re-solves and braking retry share them, which bounds
+                        the work of a step); < 0: each QP may take qp_max_iter (the full SQP) */
     HM_REAL screened_lg[HM_N + 1][HM_NG];
     unsigned char screened[HM_N + 1][HM_NG];
     /* The QP of the current linearisation and its solver. */
     HM_NS(ocp_qp) qp;
-    HM_NS(ocp_qp_sol) qp_sol;
     HM_NS(ocp_qp_ipm_arg) ipm_arg;
     HM_NS(ocp_qp_ipm_ws) ipm_ws;
     /* The linearisation point during a line search (full SQP). */

@@ -115,6 +115,7 @@ HM_FUNC int ocp_qp_check(const hm_ocp_qp *qp)
     for (n = 1; n <= HM_N; n++) {
         if (qp->ng[n] < 0 || qp->ng[n] > HM_NG) return HM_QP_NONFINITE;
         for (i = 0; i < qp->ng[n]; i++) {
+            if (qp->lg[n][i] == -HM_INF) continue;   /* absent: no solver reads it (most rows of a screened QP) */
             if (!ocp_qp_all_finite(qp->D[n][i], HM_NP) || isnan(qp->lg[n][i])) return HM_QP_NONFINITE;
             if (qp->soft[n][i] && (!isfinite(qp->zl[n][i]) || !isfinite(qp->Zl[n][i])))
                 return HM_QP_NONFINITE;

@@ -27,7 +27,8 @@ HM_FUNC void ocp_qp_sol_set_zero(hm_ocp_qp_sol *sol);
 
 /* 0 if the data that takes part in the problem is usable, else HM_QP_NONFINITE: a NaN anywhere in
  * it, an infinity outside a bound (where it means "absent"), or ng out of 0..HM_NG. Stage-0 bounds
- * and rows, and rows i >= ng_n, are not part of the problem and may hold anything. */
+ * and rows, rows i >= ng_n and rows absent by lg = -HM_INF are not part of the problem and may hold
+ * anything. */
 HM_FUNC int ocp_qp_check(const hm_ocp_qp *qp);
 
 /* 1 if the bound or row right-hand side takes part in the problem. */

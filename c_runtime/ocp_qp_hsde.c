@@ -36,7 +36,7 @@ HM_FUNC hm_real ocp_qp_hsde_tau_pivot(const hm_ocp_qp *restrict qp, const hm_ocp
             acc += ws->soft_Zl[n][j] * ds * ds;
         }
     }
-    for (j = 0; j < ws->m; j++) acc += v1->z[j] * v1->z[j] * ws->winv[j];
+    for (j = 0; j < ws->m; j++) acc += v1->z[j] * v1->z[j] * ocp_qp_hsde_weight(ws->t[j], v->z[j], ws->w_max).winv;
     return -acc;
 }
 
@@ -81,7 +81,7 @@ HM_FUNC hm_real ocp_qp_hsde_direction(const hm_ocp_qp *restrict qp, hm_ocp_qp_hs
     for (n = 0; n < HM_N; n++) {
         for (i = 0; i < HM_NX; i++) d->y[n][i] = -keep * r->y[n][i];
     }
-    for (j = 0; j < ws->m; j++) d->z[j] = ws->ds[j] * ws->zinv[j] - keep * r->z[j];
+    for (j = 0; j < ws->m; j++) d->z[j] = ws->ds[j] * ocp_qp_hsde_weight(ws->t[j], ws->v.z[j], ws->w_max).zinv - keep * r->z[j];
     dtau = (dk / tau - keep * ws->rtau - ocp_qp_hsde_kkt_solve(qp, ws, d, d)) / den;
     ocp_qp_hsde_vec_axpy_except_z(ws, dtau, v1, d);
     ws->dtau = dtau;
@@ -91,7 +91,7 @@ HM_FUNC hm_real ocp_qp_hsde_direction(const hm_ocp_qp *restrict qp, hm_ocp_qp_hs
     for (j = 0; j < ws->m; j++) {
         const hm_real dz = d->z[j] + dtau * v1->z[j];
         const hm_real tj = ws->t[j], zj = ws->v.z[j];
-        const hm_real dtj = -(ws->ds[j] + tj * dz) * ws->zinv[j];
+        const hm_real dtj = -(ws->ds[j] + tj * dz) * ocp_qp_hsde_weight(tj, zj, ws->w_max).zinv;
         d->z[j] = dz;
         ws->dt[j] = dtj;
         if (-dtj * a > tj) a = -tj / dtj;
@@ -307,6 +307,7 @@ HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
         ws->out.status = status;
         return status;
     }
+    if (status) return ocp_qp_hsde_finish(qp, sol, ws, status, HM_R(0.0), 0, 0);
     status = ocp_qp_hsde_init(qp, ws);
     if (status) return ocp_qp_hsde_finish(qp, sol, ws, status, HM_R(0.0), 0, 0);
 

@@ -25,9 +25,11 @@
 #define OCP_QP_HSDE_H
 
 #include "hm_common.h"
+#include "ocp_qp_kkt.h"
 
-/* Inequality rows of one stage at most, and of the whole QP. */
-#define HM_QP_HSDE_NC_STAGE (2 * (HM_NU + HM_NX) + 2 * HM_NG)
+/* Inequality rows of one stage at most (both sides of the components that may be bounded,
+ * HM_QP_NBP of ocp_qp_kkt.h), and of the whole QP. */
+#define HM_QP_HSDE_NC_STAGE (2 * HM_QP_NBP + 2 * HM_NG)
 #define HM_QP_HSDE_NC_MAX ((HM_N + 1) * HM_QP_HSDE_NC_STAGE)
 
 /* Solve qp from scratch; returns an enum hm_qp_status (also in ws->out.status); ws->out.iter iterations. */

@@ -1,6 +1,6 @@
 /*
  * ocp_qp_hsde_common.h: what the files of the fallback solver (ocp_qp_hsde*.c) share: max without
- * libm. No state.
+ * libm, the row weights of the Newton matrix. No state.
  */
 #ifndef OCP_QP_HSDE_COMMON_H
 #define OCP_QP_HSDE_COMMON_H
@@ -9,5 +9,29 @@
 
 /* max without libm's fmax call (whose NaN rule is not needed here: NaN is caught on the sums) */
 #define OCP_QP_HSDE_MAX(a, b) ((a) > (b) ? (a) : (b))
+
+/* A row's weight of the Newton matrix at (t, z): w = min(z / t, w_max), with 1 / w and 1 / z, one
+ * division. The residuals keep w (ws->w, which the polish sets otherwise too); the tau pivot and the
+ * directions derive 1 / w and 1 / z again from the same t and z, the same values without an array
+ * each. */
+typedef struct {
+    hm_real w, winv, zinv;
+} ocp_qp_hsde_row_weight;
+
+HM_KERNEL ocp_qp_hsde_row_weight ocp_qp_hsde_weight(hm_real tj, hm_real zj, hm_real w_max)
+{
+    ocp_qp_hsde_row_weight r;
+    const hm_real inv = HM_R(1.0) / (tj * zj);
+    const hm_real wj = zj * zj * inv;
+    r.zinv = tj * inv;
+    if (wj < w_max) {
+        r.w = wj;
+        r.winv = tj * tj * inv;
+    } else {
+        r.w = w_max;
+        r.winv = HM_R(1.0) / w_max;
+    }
+    return r;
+}
 
 #endif /* OCP_QP_HSDE_COMMON_H */

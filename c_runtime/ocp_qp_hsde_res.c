@@ -53,7 +53,7 @@ HM_FUNC void ocp_qp_hsde_stage_hess_mul(const hm_ocp_qp *restrict qp, int n, hm_
  *   rv.ux, rv.s = P v + A' w + q tau,   rv.y = A_E v - b_E tau,   rv.z = A_I v + t - b_I tau,
  *   rtau = kappa + q' v + b' w + v' P v / tau,
  * the vector c = q + 2 P v / tau of the tau row, and the scalars of the termination tests. With
- * weights, also the row weights of the Newton matrix at this point (ws->w, ws->winv, ws->zinv). */
+ * weights, also the row weights of the Newton matrix at this point (ws->w). */
 HM_FUNC void ocp_qp_hsde_residuals(const hm_ocp_qp *restrict qp, hm_ocp_qp_hsde_ws *restrict ws,
                                   const hm_ocp_qp_hsde_vec *restrict v, const hm_real *restrict t, hm_real tau,
                                   int weights, ocp_qp_hsde_sums *restrict sm)
@@ -178,8 +178,7 @@ HM_FUNC void ocp_qp_hsde_residuals(const hm_ocp_qp *restrict qp, hm_ocp_qp_hsde_
             }
         }
     }
-    /* and, for the Newton matrix of this iterate, the row weights w = min(z / t, w_max), 1 / w and
-     * 1 / z, with one division per row */
+    /* and, for the Newton matrix of this iterate, the row weights w = min(z / t, w_max) */
     for (j = 0; j < ws->m; j++) {
         const hm_real zj = v->z[j], tj = t[j];
         rp = OCP_QP_HSDE_MAX(rp, hm_fabs(r->z[j]));
@@ -189,19 +188,7 @@ HM_FUNC void ocp_qp_hsde_residuals(const hm_ocp_qp *restrict qp, hm_ocp_qp_hsde_
         nw = OCP_QP_HSDE_MAX(nw, zj);
         nt = OCP_QP_HSDE_MAX(nt, tj);
     }
-    for (j = 0; weights && j < ws->m; j++) {
-        const hm_real zj = v->z[j], tj = t[j];
-        const hm_real inv = HM_R(1.0) / (tj * zj);
-        const hm_real wj = zj * zj * inv;
-        ws->zinv[j] = tj * inv;
-        if (wj < w_max) {
-            ws->w[j] = wj;
-            ws->winv[j] = tj * tj * inv;
-        } else {
-            ws->w[j] = w_max;
-            ws->winv[j] = HM_R(1.0) / w_max;
-        }
-    }
+    for (j = 0; weights && j < ws->m; j++) ws->w[j] = ocp_qp_hsde_weight(t[j], v->z[j], w_max).w;
     ws->rtau = ws->kappa + qv + bw + vPv / tau;
     sm->qv = qv;
     sm->bw = bw;

@@ -24,7 +24,7 @@ HM_FUNC void ocp_qp_hsde_stage_hess_mul(const hm_ocp_qp *restrict qp, int n, hm_
  *   rv.ux, rv.s = P v + A' w + q tau,   rv.y = A_E v - b_E tau,   rv.z = A_I v + t - b_I tau,
  *   rtau = kappa + q' v + b' w + v' P v / tau,
  * the vector c = q + 2 P v / tau of the tau row, and the scalars of the termination tests. With
- * weights, also the row weights of the Newton matrix at this point (ws->w, ws->winv, ws->zinv). */
+ * weights, also the row weights of the Newton matrix at this point (ws->w). */
 HM_FUNC void ocp_qp_hsde_residuals(const hm_ocp_qp *restrict qp, hm_ocp_qp_hsde_ws *restrict ws,
                                   const hm_ocp_qp_hsde_vec *restrict v, const hm_real *restrict t, hm_real tau,
                                   int weights, ocp_qp_hsde_sums *restrict sm);

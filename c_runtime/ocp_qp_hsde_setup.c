@@ -23,13 +23,14 @@
 
 
 /* Packs the present inequality rows and computes the data of the embedding and its norms. Returns
- * HM_QP_INFEASIBLE if a lower bound exceeds its upper bound; *bad = stage * HM_QP_NUX + component. */
+ * HM_QP_INFEASIBLE if a lower bound exceeds its upper bound (*bad = stage * HM_QP_NUX + component),
+ * HM_QP_NONFINITE if a stage bounds more components than the solver was sized for (HM_QP_NBP). */
 HM_FUNC int ocp_qp_hsde_setup(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws, int *bad)
 {
     int n, i, k, m = 0;
     hm_real norm_q = HM_R(0.0), norm_b = HM_R(0.0), hscale = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
-        int nb = 0, nr = 0, ns = 0;
+        int nb = 0, nr = 0, ns = 0, nbc = 0;
         ws->off[n] = m;
         for (i = 0; i < HM_QP_NUX; i++) {
             hm_real lb, ub;
@@ -42,6 +43,8 @@ HM_FUNC int ocp_qp_hsde_setup(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws, int *b
                 lb = qp->lbx[n][i - HM_NU];
                 ub = qp->ubx[n][i - HM_NU];
             }
+            /* more bounded components than the solver has room for (HM_QP_NBP): a QP of another shape */
+            if ((ocp_qp_bound_present(lb) || ocp_qp_bound_present(ub)) && ++nbc > HM_QP_NBP) return HM_QP_NONFINITE;
             if (ocp_qp_bound_present(lb)) {
                 if (ocp_qp_bound_present(ub) && lb > ub) {
                     *bad = n * HM_QP_NUX + i;

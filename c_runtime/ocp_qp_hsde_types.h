@@ -6,6 +6,17 @@
  */
 #include "hm_common.h"
 
+/* Inequality rows of one stage at most: both sides of each component of (u, x) that may be bounded
+ * (HM_NBP, default all six: ocp_qp_ipm_types.h), and each general row with the s >= 0 of a soft one;
+ * written out (no include guard) as HM_QP_HSDE_NC_STAGE of ocp_qp_hsde.h. */
+#ifdef HM_NBP
+#define HM_TYPES_HSDE_NC_ (2 * (HM_NBP) + 2 * HM_NG)
+#define HM_TYPES_HSDE_NB_ (2 * (HM_NBP))
+#else
+#define HM_TYPES_HSDE_NC_ (2 * (HM_NU + HM_NX) + 2 * HM_NG)
+#define HM_TYPES_HSDE_NB_ (2 * (HM_NU + HM_NX))
+#endif
+
 /* The variables of the embedding that live in the QP's shape: per stage (u, x) (u of stage HM_N and
  * x of stage 0 unused), slacks s[n][k] of the k-th general row if it is soft, multipliers y of the
  * dynamics and z of the packed inequality rows. Used for the iterate, the step, the residuals and a
@@ -14,7 +25,7 @@ typedef struct HM_NS(ocp_qp_hsde_vec) {
     HM_REAL ux[HM_N + 1][HM_NU + HM_NX];
     HM_REAL s[HM_N + 1][HM_NG];
     HM_REAL y[HM_N][HM_NX];
-    HM_REAL z[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
+    HM_REAL z[(HM_N + 1) * HM_TYPES_HSDE_NC_];
 } HM_NS(ocp_qp_hsde_vec);
 
 /* The fallback solver (ocp_qp_hsde.h): inequality rows (present bounds, general rows, s >= 0 of
@@ -30,8 +41,8 @@ typedef struct HM_NS(ocp_qp_hsde_ws) {
     int nb[HM_N + 1];
     int nr[HM_N + 1];
     int ns[HM_N + 1];
-    unsigned char box_comp[HM_N + 1][2 * (HM_NU + HM_NX)];   /* component of (u, x) */
-    HM_REAL box_sign[HM_N + 1][2 * (HM_NU + HM_NX)];          /* +1 upper bound, -1 lower bound */
+    unsigned char box_comp[HM_N + 1][HM_TYPES_HSDE_NB_];   /* component of (u, x) */
+    HM_REAL box_sign[HM_N + 1][HM_TYPES_HSDE_NB_];          /* +1 upper bound, -1 lower bound */
     unsigned char row_idx[HM_N + 1][HM_NG];   /* QP row i of the k-th general row */
     unsigned char soft_of[HM_N + 1][HM_NG];   /* k of the j-th soft row */
     HM_REAL D[HM_N + 1][HM_NG][HM_NP];        /* D of the k-th general row */
@@ -41,24 +52,22 @@ typedef struct HM_NS(ocp_qp_hsde_ws) {
     HM_REAL q_ux[HM_N + 1][HM_NU + HM_NX];
     HM_REAL q_s[HM_N + 1][HM_NG];
     HM_REAL b_eq[HM_N][HM_NX];
-    HM_REAL b_ineq[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
+    HM_REAL b_ineq[(HM_N + 1) * HM_TYPES_HSDE_NC_];
     HM_REAL norm_q, norm_b;
     HM_REAL cost_scale;               /* the cost is solved scaled by this */
     HM_REAL w_max;                    /* cap of the row weights */
 
     /* iterate (v, t, tau, kappa), step, constant solve, residuals */
     HM_NS(ocp_qp_hsde_vec) v, dv, v1, rv;
-    HM_REAL t[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
-    HM_REAL dt[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
+    HM_REAL t[(HM_N + 1) * HM_TYPES_HSDE_NC_];
+    HM_REAL dt[(HM_N + 1) * HM_TYPES_HSDE_NC_];
     HM_REAL dtau, dkappa, rtau;
     HM_REAL c_ux[HM_N + 1][HM_NU + HM_NX];   /* q + 2 P v / tau, the tau row of the Newton system */
     HM_REAL c_s[HM_N + 1][HM_NG];
-    HM_REAL ds[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];   /* complementarity target */
-    HM_REAL zinv[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];   /* 1 / z */
-    HM_REAL winv[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];   /* 1 / w */
+    HM_REAL ds[(HM_N + 1) * HM_TYPES_HSDE_NC_];   /* complementarity target */
 
     /* Newton system: row weights z / t, stage-wise eliminated soft slacks, Riccati */
-    HM_REAL w[(HM_N + 1) * (2 * (HM_NU + HM_NX) + 2 * HM_NG)];
+    HM_REAL w[(HM_N + 1) * HM_TYPES_HSDE_NC_];
     HM_REAL soft_hinv[HM_N + 1][HM_NG];     /* of the j-th soft row: 1 / (Zl + w_row + w_slack) */
     HM_REAL soft_e[HM_N + 1][HM_NG];        /* per solve: its slack step at a zero position step */
     HM_REAL P[HM_N + 1][HM_NX * HM_NX];     /* cost-to-go Hessians */
@@ -68,3 +77,6 @@ typedef struct HM_NS(ocp_qp_hsde_ws) {
     HM_REAL Y[HM_N][HM_NU * HM_NX];         /* Lr^-1 (S + B' P A) */
     HM_REAL yk[HM_N][HM_NU];                /* per solve: Lr^-1 (reduced input gradient) */
 } HM_NS(ocp_qp_hsde_ws);
+
+#undef HM_TYPES_HSDE_NC_
+#undef HM_TYPES_HSDE_NB_

@@ -127,13 +127,21 @@ HM_FUNC int ocp_qp_ipm_finish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp
     } else {
         ocp_qp_ipm_write_sol(qp, ws, sol, HM_R(1.0) / ws->cost_scale, HM_R(1.0));
     }
+#ifdef HM_QP_POLISH
     polish = status == HM_QP_SOLVED && (polish == 1 || (polish == 2 && ocp_qp_ipm_undecided(ws, alpha)));
+#else
+    /* built without the polish (ocp_qp_ipm_types.h: HM_QP_POLISH): arg->polish has no effect */
+    polish = 0;
+    (void)alpha;
+#endif
     if (residuals || polish || status != HM_QP_SOLVED) {
         ocp_qp_res_compute(qp, sol, &ws->out.res);
     } else {
         ws->out.res.stat = ws->out.res.eq = ws->out.res.ineq = ws->out.res.comp = ws->out.res.dual = ws->out.res.obj = HM_R(0.0);
     }
+#ifdef HM_QP_POLISH
     if (polish) ocp_qp_ipm_polish(qp, sol, ws, alpha);
+#endif
     ws->out.status = status;
     return status;
 }
@@ -162,6 +170,43 @@ HM_KERNEL int ocp_qp_ipm_rp_stuck(int iter, hm_real mu, hm_real mu0, hm_real rp,
 {
     return iter > 1 && mu < HM_R(1e-2) * mu0 && rp * mu0 > HM_R(1e3) * rp0 * mu;
 }
+
+#ifdef HM_REAL_IS_FLOAT
+/* Single precision's rounding floor. The dual residual of the RTI's QPs stops falling near 1e-6
+ * (scaled): a soft row's multiplier is its L1 weight less its slack bound's, two numbers of about 1
+ * (the exact penalty sets the cost scale) whose difference is the small multiplier of an inactive row,
+ * and the Newton steps carry that rounding into the stationarity of the positions. The duality gap
+ * in the data's units, which the tests of ocp_qp_ipm_solve want below tol, is mu times the number of
+ * inequalities times the inverse cost scale (1e4): pushing mu down for it saturated the weights z / t,
+ * the dual residual rose again and the steps failed (a negative Riccati pivot, the iteration limit;
+ * the fallback, from scratch, met the same floor: docs/firmware.md). Two tests on the exact measures
+ * therefore stand in for the gap in single precision:
+ *   in every iteration with mu <= OCP_QP_IPM_FLOAT_DEEP tol (per inequality, scaled: HPIPM's
+ *   complementarity test, with a margin of 50), the others of ocp_qp_ipm_solve as they are: primal and
+ *   dual residual within tol, natural residual within 10 tol;
+ *   where an iteration is about to fail (a refused pivot, a hand-over to the fallback, the iteration
+ *   limit; rescue), on the iterate it started from (pass A's, which the later passes do not move):
+ *   primal residual within tol, dual residual within 10 tol, mu within tol and the natural residual
+ *   within 10 max(tol, sqrt(mu)) (a degenerate pair has t = z = sqrt(mu)).
+ * Measured on the recorded replays (docs/firmware.md): no float QP fails where double solves. */
+#define OCP_QP_IPM_FLOAT_DEEP HM_R(2e-2)
+
+HM_FUNC int ocp_qp_ipm_at_float_floor(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_arg *arg,
+                                      ocp_qp_ipm_sums *sm, int rescue)
+{
+    const hm_real mdeg = ws->m > 0 ? (hm_real)ws->m : HM_R(1.0);
+    const hm_real mu = sm->tz / mdeg;
+    hm_real np, nd;
+    if (!sm->exact) ocp_qp_ipm_stage_measures(qp, ws, sm);
+    if (!sm->measured) ocp_qp_ipm_row_measures(ws, sm);
+    np = OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_b), OCP_QP_IPM_MAX(sm->av_eq, OCP_QP_IPM_MAX(sm->av_ineq, sm->nt)));
+    nd = OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(HM_R(1.0), ws->norm_q),
+                        OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(sm->pv, sm->atw), OCP_QP_IPM_MAX(sm->pv_s, sm->atw_s)));
+    if (!rescue) return sm->rp <= arg->tol * np && sm->rd <= arg->tol * nd && sm->ncr <= HM_R(10.0) * arg->tol;
+    return sm->rp <= arg->tol * np && sm->rd <= HM_R(10.0) * arg->tol * nd && mu <= arg->tol
+           && sm->ncr <= HM_R(10.0) * OCP_QP_IPM_MAX(arg->tol, hm_sqrt(mu));
+}
+#endif
 
 /* ocp_qp_ipm_run's answer when a warm-started iteration stalls: the caller starts cold again */
 #define OCP_QP_IPM_COLD_AGAIN (-100)
@@ -193,6 +238,7 @@ HM_FUNC int ocp_qp_ipm_run(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ip
         ws->out.status = status;
         return status;
     }
+    if (status) return ocp_qp_ipm_finish(qp, sol, ws, status, HM_R(0.0), 0, 0, 1, HM_R(0.0));
 
     if (warm) ocp_qp_ipm_warm_apply(ws, arg->warm_start == 1);
     for (;;) {
@@ -281,14 +327,20 @@ HM_FUNC int ocp_qp_ipm_run(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ip
             status = HM_QP_SOLVED;
             break;
         }
+#ifdef HM_REAL_IS_FLOAT
+        /* deep enough that a QP away from the floor has met the tests above (its gap falls with mu) */
+        if (mu <= OCP_QP_IPM_FLOAT_DEEP * arg->tol && ocp_qp_ipm_at_float_floor(qp, ws, arg, &sm, 0)) {
+            status = HM_QP_SOLVED;
+            break;
+        }
+#endif
         if (sm.bw < HM_R(0.0) && sm.atw <= arg->tol_infeas * -sm.bw) {
             status = HM_QP_INFEASIBLE;
             break;
         }
         if (ws->out.iter > 0 && alpha < HM_R(0.5)) {
             hm_real bwr;
-            ocp_qp_ipm_ray_from_step(ws);
-            if (ocp_qp_ipm_farkas(qp, ws, &ws->u.f.va, arg->tol_infeas, &bwr)) {
+            if (ocp_qp_ipm_farkas_step(qp, ws, arg->tol_infeas, &bwr)) {
                 status = HM_QP_INFEASIBLE;
                 ray = 1;
                 sm.bw = bwr;
@@ -407,13 +459,20 @@ HM_FUNC int ocp_qp_ipm_run(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_ip
             break;
         }
     }
+#ifdef HM_REAL_IS_FLOAT
+    if ((fallback || status == HM_QP_MAX_ITER || (status == HM_QP_NUMERICAL && !ws->out.unbounded))
+        && ocp_qp_ipm_at_float_floor(qp, ws, arg, &sm, 1)) {
+        fallback = 0;
+        status = HM_QP_SOLVED;
+    }
+#endif
     if (fallback) {
         if (warm) return OCP_QP_IPM_COLD_AGAIN;
         OCP_QP_IPM_PROF(OCP_QP_IPM_PROF_FINISH, status = ocp_qp_ipm_fallback(qp, sol, ws, arg));
         return status;
     }
     if (ray) {
-        ocp_qp_ipm_write_sol_vec(qp, ws, &ws->u.f.va, sol, HM_R(1.0) / -sm.bw);
+        ocp_qp_ipm_write_sol_ray(qp, ws, sol, HM_R(1.0) / -sm.bw);
         ocp_qp_res_compute(qp, sol, &ws->out.res);
         ws->out.status = status;
         return status;

@@ -29,7 +29,9 @@
  *               data) in absolute terms or relative to max(1, |cost|), all below arg->tol. Then, with
  *               arg->polish, the active-set polish (ocp_qp_ipm_polish.c): the QP solved once more as an
  *               equality-constrained QP on the rows the iterate has active, kept only if its worst
- *               KKT residual (ocp_qp_res_compute) is smaller (ws->out.polished).
+ *               KKT residual (ocp_qp_res_compute) is smaller (ws->out.polished). The polish is
+ *               compiled in only with HM_QP_POLISH (the tests' QP builds, ocp_qp_ipm_types.h); a
+ *               generated solver never polishes and leaves its memory out.
  *   INFEASIBLE  the dual iterate is a Farkas certificate: b' w < 0 and ||A' w||_inf <=
  *               tol_infeas * (-b' w), w = (y, z), z >= 0 (as every iterate's). Then every (u, x, s)
  *               satisfying the hard constraints has ||(u, x, s)||_1 >= 1 / tol_infeas: there is none

@@ -14,7 +14,7 @@ typedef struct HM_NS(ocp_qp_ipm_arg) {
     HM_REAL tol_infeas;      /* certificate: no feasible point has ||(u, x, s)||_1 < 1 / tol_infeas */
     HM_REAL step_frac;       /* fraction of the step to the boundary that is taken */
     HM_REAL min_step;        /* a shorter step means no progress: HM_QP_NUMERICAL */
-    int polish;              /* 1: refine a solution on its active set (ocp_qp_ipm.h) */
+    int polish;              /* 1: refine a solution on its active set (ocp_qp_ipm.h; with HM_QP_POLISH) */
     int residuals;           /* 1: ws->out.res holds the KKT residuals of the returned solution; 0: a solved
                                 QP's are left out (the polish still measures them) */
     int detect_unbounded;    /* 1: test stalling steps for a ray of unbounded descent (ocp_qp_ipm.h); 0 for

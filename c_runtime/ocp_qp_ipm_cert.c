@@ -7,10 +7,19 @@
 #include "ocp_qp_ipm_common.h"
 #include "ocp_qp_ipm_cert.h"
 
-/* Farkas test of the dual part w = (y, z) of a vector in the solver's layout: b' w < 0 and
- * ||A' w||_inf <= tol_infeas * (-b' w) (z >= 0 is the caller's). Returns 1 if it passes, with b' w. */
-HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_vec *w,
-                              hm_real tol_infeas, hm_real *bw_out)
+/* The candidate certificate of a stalling iteration: the dual part of the last step's direction,
+ * its multiplier steps clipped at 0 (when the multipliers diverge along a certificate, their steps
+ * point along it with less of the bounded part that the iterate carries), read where the step is
+ * kept: y = dy, z = max(dz, 0) of each inequality. */
+HM_KERNEL hm_real ocp_qp_ipm_ray_z(hm_real dz)
+{
+    return OCP_QP_IPM_MAX(dz, HM_R(0.0));
+}
+
+/* Farkas test of that ray w = (y, z): b' w < 0 and ||A' w||_inf <= tol_infeas * (-b' w) (z >= 0 by
+ * the clipping). Returns 1 if it passes, with b' w. */
+HM_FUNC int ocp_qp_ipm_farkas_step(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, hm_real tol_infeas,
+                                   hm_real *bw_out)
 {
     const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
@@ -23,7 +32,7 @@ HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, c
         hm_real atw[HM_QP_NUX];
         for (i = 0; i < HM_QP_NUX; i++) atw[i] = HM_R(0.0);
         if (n < HM_N) {
-            const hm_real *y = w->y[n];
+            const hm_real *y = sn->dy;
             for (i = 0; i < HM_NU; i++) atw[i] -= ocp_qp_kkt_dot4(qp->B[n] + i * HM_NX, y);
             if (n > 0) {
                 for (i = 0; i < HM_NX; i++) atw[HM_NU + i] -= ocp_qp_kkt_dot4(qp->A[n] + i * HM_NX, y);
@@ -31,27 +40,30 @@ HM_FUNC int ocp_qp_ipm_farkas(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, c
             for (i = 0; i < HM_NX; i++) bw += sn->beq[i] * y[i];
         }
         if (n > 0) {
-            for (i = 0; i < HM_NX; i++) atw[HM_NU + i] += w->y[n - 1][i];
+            for (i = 0; i < HM_NX; i++) atw[HM_NU + i] += ws->u.f.st[n - 1].dy[i];
         }
         for (k = 0; k < bd->nbp; k++) {
             for (l = 0; l < 2; l++) {
                 const hm_real sg = bd->sg[k][l][n];
-                atw[bd->bc[k]] += sg * w->zb[n][k][l];
-                bw += sg * sg * bd->b[k][l][n] * w->zb[n][k][l];
+                const hm_real zb = ocp_qp_ipm_ray_z(bd->dz[k][l][n]);
+                atw[bd->bc[k]] += sg * zb;
+                bw += sg * sg * bd->b[k][l][n] * zb;
             }
         }
         for (j = 0; j < sn->ns; j++) {
             const int row = sn->soff + j;
-            const hm_real as = OCP_QP_IPM_ABS(w->zr[n][j] + w->zs[n][j]);
-            atw[HM_NU] -= sr->sd0[row] * w->zr[n][j];
-            atw[HM_NU + 1] -= sr->sd1[row] * w->zr[n][j];
-            bw -= sr->slg[row] * w->zr[n][j];
+            const hm_real zr = ocp_qp_ipm_ray_z(sr->sdz[row]), zs = ocp_qp_ipm_ray_z(sr->sdzs[row]);
+            const hm_real as = OCP_QP_IPM_ABS(zr + zs);
+            atw[HM_NU] -= sr->sd0[row] * zr;
+            atw[HM_NU + 1] -= sr->sd1[row] * zr;
+            bw -= sr->slg[row] * zr;
             atw_n = OCP_QP_IPM_MAX(atw_n, as);
         }
         for (j = 0; j < sn->nh; j++) {
-            atw[HM_NU] -= sn->hd0[j] * w->zh[n][j];
-            atw[HM_NU + 1] -= sn->hd1[j] * w->zh[n][j];
-            bw -= sn->hlg[j] * w->zh[n][j];
+            const hm_real zh = ocp_qp_ipm_ray_z(sn->hdz[j]);
+            atw[HM_NU] -= sn->hd0[j] * zh;
+            atw[HM_NU + 1] -= sn->hd1[j] * zh;
+            bw -= sn->hlg[j] * zh;
         }
         for (i = c0; i < c1; i++) atw_n = OCP_QP_IPM_MAX(atw_n, OCP_QP_IPM_ABS(atw[i]));
     }
@@ -105,32 +117,4 @@ HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws
         for (j = 0; j < sn->nh; j++) ad = OCP_QP_IPM_MAX(ad, -(sn->hd0[j] * d[HM_NU] + sn->hd1[j] * d[HM_NU + 1]));
     }
     return qd < HM_R(0.0) && OCP_QP_IPM_MAX(pd * cinv, ad) <= tol_infeas * -qd * cinv;
-}
-
-/* The dual part of the last step's direction, its multiplier steps clipped at 0, into ws->u.f.va (primal
- * part zero): when the multipliers diverge along a certificate, their steps point along it with
- * less of the bounded part that the iterate carries. */
-HM_FUNC void ocp_qp_ipm_ray_from_step(hm_ocp_qp_ipm_ws *ws)
-{
-    const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
-    const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
-    hm_ocp_qp_ipm_vec *v = &ws->u.f.va;
-    int n, i, k, j, l;
-    for (n = 0; n <= HM_N; n++) {
-        const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
-        for (i = 0; i < HM_QP_NUX; i++) v->ux[n][i] = HM_R(0.0);
-        if (n < HM_N) {
-            for (i = 0; i < HM_NX; i++) v->y[n][i] = sn->dy[i];
-        }
-        for (k = 0; k < bd->nbp; k++) {
-            for (l = 0; l < 2; l++) v->zb[n][k][l] = OCP_QP_IPM_MAX(bd->dz[k][l][n], HM_R(0.0));
-        }
-        for (j = 0; j < sn->ns; j++) {
-            const int row = sn->soff + j;
-            v->s[n][j] = HM_R(0.0);
-            v->zr[n][j] = OCP_QP_IPM_MAX(sr->sdz[row], HM_R(0.0));
-            v->zs[n][j] = OCP_QP_IPM_MAX(sr->sdzs[row], HM_R(0.0));
-        }
-        for (j = 0; j < sn->nh; j++) v->zh[n][j] = OCP_QP_IPM_MAX(sn->hdz[j], HM_R(0.0));
-    }
 }

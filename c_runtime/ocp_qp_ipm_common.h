@@ -14,6 +14,11 @@
  * HM_QP_NNP, the length of the row list of ocp_qp_ipm_rows HM_QP_NR */
 typedef char ocp_qp_ipm_nr_matches[sizeof(((hm_ocp_qp_ipm_rows *)0)->ss) == HM_QP_NR * sizeof(hm_real) ? 1 : -1];
 typedef char ocp_qp_ipm_nnp_matches[sizeof(((hm_ocp_qp_ipm_bounds *)0)->v[0]) == HM_QP_NNP * sizeof(hm_real) ? 1 : -1];
+/* and the bound slots and the hard-row slots per stage */
+typedef char ocp_qp_ipm_nbp_matches[sizeof(((hm_ocp_qp_ipm_bounds *)0)->bc) == HM_QP_NBP ? 1 : -1];
+typedef char ocp_qp_ipm_nghp_matches[sizeof(((hm_ocp_qp_ipm_stage *)0)->hrow) == HM_QP_NGHP ? 1 : -1];
+typedef char ocp_qp_ipm_nbp_range[HM_QP_NBP >= 1 && HM_QP_NBP <= HM_QP_NUX ? 1 : -1];
+typedef char ocp_qp_ipm_ngh_range[HM_QP_NGH >= 0 && HM_QP_NGH <= HM_NG ? 1 : -1];
 
 /* max/min without libm's calls (whose NaN rule is not needed here: NaN is caught on the sums) */
 #define OCP_QP_IPM_MAX(a, b) ((a) > (b) ? (a) : (b))

@@ -118,6 +118,30 @@ HM_FUNC void ocp_qp_ipm_bound_side_measures(const hm_real *restrict sg, const hm
  * the stages' parts summed afterwards. Lanes keep the sums and maxima of the passes.
  * ---------------------------------------------------------------------------------------------- */
 
+/* What the passes derive from a row's iterate (s, t, z, zs) and its slack's cost (Zl, zl): the
+ * inverses, the weights z / t and zs / s (capped), the eliminated slack's 1 / (Zl + wr + ws) and the
+ * slack's stationarity residual. Pass A derives them after its step, passes C and E again from the
+ * same numbers (stored by pass A) by these same expressions: the same values, without a list for each. */
+typedef struct {
+    hm_real ti, zi, si, zsi, wr, wsl, hinv, rs;
+} ocp_qp_ipm_row_terms;
+
+HM_KERNEL ocp_qp_ipm_row_terms ocp_qp_ipm_row_derive(hm_real s, hm_real t, hm_real z, hm_real zs, hm_real Zl,
+                                                     hm_real zl, hm_real wmax)
+{
+    ocp_qp_ipm_row_terms d;
+    const hm_real ia = HM_R(1.0) / (t * z), ib = HM_R(1.0) / (s * zs);
+    d.rs = Zl * s + zl - z - zs;
+    d.ti = z * ia;
+    d.zi = t * ia;
+    d.si = zs * ib;
+    d.zsi = s * ib;
+    d.wr = OCP_QP_IPM_MIN(z * d.ti, wmax);
+    d.wsl = OCP_QP_IPM_MIN(zs * d.si, wmax);
+    d.hinv = HM_R(1.0) / (Zl + d.wr + d.wsl);
+    return d;
+}
+
 /* Pass A: the step, the weights, the eliminated slack, and per row the factors of its parts of the
  * stage's (px, py) block and gradients, we (in sdr), e (in sdsb) and cmu (in se); lanes: t z, b w,
  * q v, v P v, the primal and the slack's dual residual. */
@@ -135,27 +159,15 @@ HM_FUNC void ocp_qp_ipm_rows_a(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
             const hm_real zs = msk * (sr->szs[q] + alpha * sr->sdzs[q]) + (HM_R(1.0) - msk);
             const hm_real lg = sr->slg[q], Zl = sr->sZl[q];
             const hm_real rho = lg - sr->gp[q] - s;
-            const hm_real rs = Zl * s + sr->szl[q] - z - zs;
-            const hm_real ia = HM_R(1.0) / (t * z), ib = HM_R(1.0) / (s * zs);
-            const hm_real ti = z * ia, zi = t * ia, si = zs * ib, zsi = s * ib;
-            const hm_real wr = OCP_QP_IPM_MIN(z * ti, wmax), wsl = OCP_QP_IPM_MIN(zs * si, wmax);
-            const hm_real hinv = HM_R(1.0) / (Zl + wr + wsl);
-            const hm_real hw = hinv * wr;
-            const hm_real we = hw * (Zl + wsl);
-            const hm_real e = we * rho + hw * (rs + wsl * s);
-            const hm_real cmu = we * zi - hw * wsl * zsi;
+            const ocp_qp_ipm_row_terms d = ocp_qp_ipm_row_derive(s, t, z, zs, Zl, sr->szl[q], wmax);
+            const hm_real hw = d.hinv * d.wr;
+            const hm_real we = hw * (Zl + d.wsl);
+            const hm_real e = we * rho + hw * (d.rs + d.wsl * s);
+            const hm_real cmu = we * d.zi - hw * d.wsl * d.zsi;
             sr->ss[q] = s;
             sr->st[q] = t;
             sr->sz[q] = z;
             sr->szs[q] = zs;
-            sr->sti[q] = ti;
-            sr->szi[q] = zi;
-            sr->ssi[q] = si;
-            sr->szsi[q] = zsi;
-            sr->swr[q] = wr;
-            sr->sws[q] = wsl;
-            sr->shi[q] = hinv;
-            sr->srs[q] = rs;
             sr->sdr[q] = we;
             sr->sdsb[q] = e;
             sr->se[q] = cmu;
@@ -164,7 +176,7 @@ HM_FUNC void ocp_qp_ipm_rows_a(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
             lane[2][l] += msk * sr->szl[q] * s;
             lane[3][l] += msk * Zl * s * s;
             lane[4][l] = OCP_QP_IPM_MAX(lane[4][l], OCP_QP_IPM_ABS(t + rho));
-            lane[5][l] = OCP_QP_IPM_MAX(lane[5][l], OCP_QP_IPM_ABS(rs));
+            lane[5][l] = OCP_QP_IPM_MAX(lane[5][l], OCP_QP_IPM_ABS(d.rs));
         }
     }
 }
@@ -172,7 +184,8 @@ HM_FUNC void ocp_qp_ipm_rows_a(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
 /* Pass C: the predictor's steps from the position steps (gd), their products (kept in sdr, sdsb for
  * the corrector), per row the factor of its part of hdl on (px, py) in se; lanes: the step ratio,
  * t dz + z dt and dt dz. */
-HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real (*restrict lane)[OCP_QP_IPM_LANES])
+HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real wmax,
+                               hm_real (*restrict lane)[OCP_QP_IPM_LANES])
 {
     int r0, l;
     for (r0 = 0; r0 < nrp; r0 += OCP_QP_IPM_LANES) {
@@ -180,12 +193,13 @@ HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
             const int q = r0 + l;
             const hm_real msk = sr->slive[q];
             const hm_real s = sr->ss[q], t = sr->st[q], z = sr->sz[q], zs = sr->szs[q];
-            const hm_real wr = sr->swr[q], wsl = sr->sws[q], hinv = sr->shi[q];
-            const hm_real zi = sr->szi[q], zsi = sr->szsi[q];
+            const ocp_qp_ipm_row_terms d = ocp_qp_ipm_row_derive(s, t, z, zs, sr->sZl[q], sr->szl[q], wmax);
+            const hm_real wr = d.wr, wsl = d.wsl, hinv = d.hinv;
+            const hm_real zi = d.zi, zsi = d.zsi;
             const hm_real hw = hinv * wr, we = hw * (sr->sZl[q] + wsl);
             const hm_real gd = sr->gd[q];
             const hm_real rho = sr->slg[q] - sr->gp[q] - s;
-            const hm_real ds = hinv * (wr * rho - wsl * s - sr->srs[q]) - hw * gd;
+            const hm_real ds = hinv * (wr * rho - wsl * s - d.rs) - hw * gd;
             const hm_real dz = wr * (rho - gd - ds);
             const hm_real dzs = -wsl * (s + ds);
 #ifdef OCP_QP_IPM_DT_PRIMAL
@@ -198,8 +212,8 @@ HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
             sr->sdr[q] = dr;
             sr->sdsb[q] = dsb;
             sr->se[q] = coef;
-            lane[0][l] = OCP_QP_IPM_MAX(lane[0][l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sr->sti[q], -dz * zi),
-                                                                  OCP_QP_IPM_MAX(-ds * sr->ssi[q], -dzs * zsi)));
+            lane[0][l] = OCP_QP_IPM_MAX(lane[0][l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * d.ti, -dz * zi),
+                                                                  OCP_QP_IPM_MAX(-ds * d.si, -dzs * zsi)));
             lane[1][l] += msk * (t * dz + z * dt + s * dzs + zs * ds);
             lane[2][l] += msk * (dr + dsb);
         }
@@ -208,23 +222,24 @@ HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
 
 /* Pass E: the corrector's steps (target smu, second-order term kdel * (sdr, sdsb)); lane: the step
  * ratio. */
-HM_FUNC void ocp_qp_ipm_rows_e(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real smu, hm_real kdel,
+HM_FUNC void ocp_qp_ipm_rows_e(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real wmax, hm_real smu, hm_real kdel,
                                hm_real *restrict lane)
 {
     int r0, l;
     for (r0 = 0; r0 < nrp; r0 += OCP_QP_IPM_LANES) {
         for (l = 0; l < OCP_QP_IPM_LANES; l++) {
             const int q = r0 + l;
-            const hm_real s = sr->ss[q], t = sr->st[q], z = sr->sz[q];
-            const hm_real wr = sr->swr[q], wsl = sr->sws[q], hinv = sr->shi[q];
-            const hm_real zi = sr->szi[q], zsi = sr->szsi[q];
+            const hm_real s = sr->ss[q], t = sr->st[q], z = sr->sz[q], zs = sr->szs[q];
+            const ocp_qp_ipm_row_terms d = ocp_qp_ipm_row_derive(s, t, z, zs, sr->sZl[q], sr->szl[q], wmax);
+            const hm_real wr = d.wr, wsl = d.wsl, hinv = d.hinv;
+            const hm_real zi = d.zi, zsi = d.zsi;
             const hm_real cr = smu - kdel * sr->sdr[q], cs = smu - kdel * sr->sdsb[q];
             const hm_real hw = hinv * wr;
             const hm_real gd = sr->gd[q];
             const hm_real rho0 = sr->slg[q] - sr->gp[q] - s;
             const hm_real rho = rho0 + cr * zi;
             const hm_real rhos = cs * zsi - s;
-            const hm_real ds = hinv * (wr * rho + wsl * rhos - sr->srs[q]) - hw * gd;
+            const hm_real ds = hinv * (wr * rho + wsl * rhos - d.rs) - hw * gd;
             const hm_real dz = wr * (rho - gd - ds);
             const hm_real dzs = wsl * (rhos - ds);
 #ifdef OCP_QP_IPM_DT_PRIMAL
@@ -237,8 +252,8 @@ HM_FUNC void ocp_qp_ipm_rows_e(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real
             sr->sdt[q] = dt;
             sr->sdz[q] = dz;
             sr->sdzs[q] = dzs;
-            lane[l] = OCP_QP_IPM_MAX(lane[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * sr->sti[q], -dz * zi),
-                                                             OCP_QP_IPM_MAX(-ds * sr->ssi[q], -dzs * zsi)));
+            lane[l] = OCP_QP_IPM_MAX(lane[l], OCP_QP_IPM_MAX(OCP_QP_IPM_MAX(-dt * d.ti, -dz * zi),
+                                                             OCP_QP_IPM_MAX(-ds * d.si, -dzs * zsi)));
         }
     }
 }

@@ -34,8 +34,9 @@ HM_FUNC void ocp_qp_ipm_bound_side_measures(const hm_real *restrict sg, const hm
 /* The soft-row list (ocp_qp_ipm_rows), nrp rows (ocp_qp_ipm_rows_blocks), OCP_QP_IPM_LANES at a time. */
 HM_FUNC void ocp_qp_ipm_rows_a(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real alpha, hm_real wmax,
                                hm_real (*restrict lane)[OCP_QP_IPM_LANES]);
-HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real (*restrict lane)[OCP_QP_IPM_LANES]);
-HM_FUNC void ocp_qp_ipm_rows_e(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real smu, hm_real kdel,
+HM_FUNC void ocp_qp_ipm_rows_c(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real wmax,
+                               hm_real (*restrict lane)[OCP_QP_IPM_LANES]);
+HM_FUNC void ocp_qp_ipm_rows_e(hm_ocp_qp_ipm_rows *restrict sr, int nrp, hm_real wmax, hm_real smu, hm_real kdel,
                                hm_real *restrict lane);
 HM_FUNC void ocp_qp_ipm_rows_measures(const hm_ocp_qp_ipm_rows *restrict sr, int nrp,
                                       hm_real (*restrict lane)[OCP_QP_IPM_LANES]);

@@ -11,6 +11,7 @@
 #include "ocp_qp_ipm_polish.h"
 #include "ocp_qp_ipm_sol.h"
 
+#ifdef HM_QP_POLISH
 /* ------------------------------------------------------------------------------------------------
  * Active-set polish
  * ---------------------------------------------------------------------------------------------- */
@@ -24,6 +25,7 @@ HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm
 {
     const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
+    const hm_ocp_qp_ipm_general *gs = &ws->u.f.gs;
     const hm_real wmax = ws->w_max;
     int n, i, k, j, l;
     for (n = 0; n <= HM_N; n++) {
@@ -65,8 +67,8 @@ HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm
         for (j = 0; j < sn->ns; j++) {
             const int row = sn->soff + j;
             const hm_real gp = sr->sd0[row] * ux[HM_NU] + sr->sd1[row] * ux[HM_NU + 1];
-            const hm_real tr = sr->swr[row] < wmax ? -d->zr[n][j] / sr->swr[row] : HM_R(0.0);
-            const hm_real ts = sr->sws[row] < wmax ? -d->zs[n][j] / sr->sws[row] : HM_R(0.0);
+            const hm_real tr = gs->swr[row] < wmax ? -d->zr[n][j] / gs->swr[row] : HM_R(0.0);
+            const hm_real ts = gs->sws[row] < wmax ? -d->zs[n][j] / gs->sws[row] : HM_R(0.0);
             r[HM_NU] -= sr->sd0[row] * d->zr[n][j];
             r[HM_NU + 1] -= sr->sd1[row] * d->zr[n][j];
             e->s[n][j] = -(sr->sZl[row] * d->s[n][j] + sr->szl[row] - d->zr[n][j] - d->zs[n][j]);
@@ -198,8 +200,9 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
 {
     hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
-    hm_ocp_qp_ipm_vec *d = &ws->u.f.va;
-    hm_ocp_qp_ipm_vec *e = &ws->u.f.vb;
+    hm_ocp_qp_ipm_general *gs = &ws->u.f.gs;
+    hm_ocp_qp_ipm_vec *d = &ws->u.f.gs.va;
+    hm_ocp_qp_ipm_vec *e = &ws->u.f.gs.vb;
     const hm_real wmax = ws->w_max;
     /* dropped inequalities keep a weight far below rounding level, not zero: a soft row's slack may
      * have neither curvature nor an active bound, and its elimination divides by the sum of three */
@@ -223,8 +226,8 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
             const int row = sn->soff + j;
             const int row_on = ocp_qp_ipm_polish_active(sr->st[row], sr->sz[row], sr->sdt[row], sr->sdz[row], alpha);
             const int slack_on = ocp_qp_ipm_polish_active(sr->ss[row], sr->szs[row], sr->sds[row], sr->sdzs[row], alpha);
-            sr->swr[row] = row_on ? wmax : w_drop;
-            sr->sws[row] = slack_on ? wmax : w_drop;
+            gs->swr[row] = row_on ? wmax : w_drop;
+            gs->sws[row] = slack_on ? wmax : w_drop;
         }
         for (j = 0; j < sn->nh; j++)
             sn->hw[j] = ocp_qp_ipm_polish_active(sn->ht[j], sn->hz[j], sn->hdt[j], sn->hdz[j], alpha) ? wmax : w_drop;
@@ -276,8 +279,8 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
             for (j = 0; j < sn->ns; j++) {
                 const int row = sn->soff + j;
                 const hm_real g = sr->sd0[row] * v[HM_NU] + sr->sd1[row] * v[HM_NU + 1] + d->s[n][j] - sr->slg[row];
-                sr->swr[row] = ocp_qp_ipm_polish_weight(sr->swr[row], &d->zr[n][j], g, wmax, w_drop, &changed);
-                sr->sws[row] = ocp_qp_ipm_polish_weight(sr->sws[row], &d->zs[n][j], d->s[n][j], wmax, w_drop, &changed);
+                gs->swr[row] = ocp_qp_ipm_polish_weight(gs->swr[row], &d->zr[n][j], g, wmax, w_drop, &changed);
+                gs->sws[row] = ocp_qp_ipm_polish_weight(gs->sws[row], &d->zs[n][j], d->s[n][j], wmax, w_drop, &changed);
             }
             for (j = 0; j < sn->nh; j++) {
                 const hm_real g = sn->hd0[j] * v[HM_NU] + sn->hd1[j] * v[HM_NU + 1] - sn->hlg[j];
@@ -298,3 +301,4 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
         ocp_qp_ipm_write_sol(qp, ws, sol, HM_R(1.0) / ws->cost_scale, HM_R(1.0));
     }
 }
+#endif /* HM_QP_POLISH */

@@ -129,7 +129,7 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                 sr->gd[j] = sr->sd0[j] * sn->dux[HM_NU] + sr->sd1[j] * sn->dux[HM_NU + 1];
         }
         for (l = 0; l < OCP_QP_IPM_LANES; l++) lane[0][l] = lane[1][l] = lane[2][l] = HM_R(0.0);
-        ocp_qp_ipm_rows_c(sr, ocp_qp_ipm_rows_blocks(sr), lane);
+        ocp_qp_ipm_rows_c(sr, ocp_qp_ipm_rows_blocks(sr), ws->w_max, lane);
         for (l = 0; l < OCP_QP_IPM_LANES; l++) {
             ratio = OCP_QP_IPM_MAX(ratio, lane[0][l]);
             tdz += lane[1][l];
@@ -226,7 +226,7 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
                 sr->gd[j] = sr->sd0[j] * sn->dux[HM_NU] + sr->sd1[j] * sn->dux[HM_NU + 1];
         }
         for (l = 0; l < OCP_QP_IPM_LANES; l++) lane[l] = HM_R(0.0);
-        ocp_qp_ipm_rows_e(sr, ocp_qp_ipm_rows_blocks(sr), smu, kdel, lane);
+        ocp_qp_ipm_rows_e(sr, ocp_qp_ipm_rows_blocks(sr), ws->w_max, smu, kdel, lane);
         for (l = 0; l < OCP_QP_IPM_LANES; l++) ratio = OCP_QP_IPM_MAX(ratio, lane[l]);
     }
     /* bound pairs, all stages of a slot at once */

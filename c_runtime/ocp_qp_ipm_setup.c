@@ -63,7 +63,8 @@ HM_FUNC void ocp_qp_ipm_rows_absent(hm_ocp_qp_ipm_rows *sr, int r)
 }
 
 /* Builds the stage blocks of qp and the starting point. Returns HM_QP_INFEASIBLE if a lower bound
- * exceeds its upper bound; *bad = stage * HM_QP_NUX + component. */
+ * exceeds its upper bound (*bad = stage * HM_QP_NUX + component), HM_QP_NONFINITE if the QP has more
+ * bounded components or hard rows in a stage than the solver was sized for (HM_QP_NBP, HM_QP_NGH). */
 HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad)
 {
     hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
@@ -92,7 +93,10 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
     }
     bd->nbp = 0;
     for (i = 0; i < HM_QP_NUX; i++) {
-        if (bounded[i]) bd->bc[bd->nbp++] = (unsigned char)i;
+        if (!bounded[i]) continue;
+        /* more bounded components than the solver has slots for: a QP of another shape */
+        if (bd->nbp == HM_QP_NBP) return HM_QP_NONFINITE;
+        bd->bc[bd->nbp++] = (unsigned char)i;
     }
     for (k = 0; k < bd->nbp; k++) {
         const int comp = bd->bc[k];
@@ -151,6 +155,7 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
                     hscale = OCP_QP_IPM_MAX(hscale, hm_fabs(qp->Zl[n][i]));
                     ns++;
                 } else {
+                    if (nh == HM_QP_NGH) return HM_QP_NONFINITE;   /* more hard rows than the solver has room for */
                     sn->hrow[nh] = (unsigned char)i;
                     sn->hd0[nh] = qp->D[n][i][0];
                     sn->hd1[nh] = qp->D[n][i][1];

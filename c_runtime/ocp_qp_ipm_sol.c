@@ -86,6 +86,64 @@ HM_FUNC void ocp_qp_ipm_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *w
     }
 }
 
+/* sol := the ray of ocp_qp_ipm_farkas_step (the last step's multiplier steps clipped at 0) scaled by
+ * sc (1 / -b'w), primal part zero but x_0 = x0: the certificate of an infeasible QP. */
+HM_FUNC void ocp_qp_ipm_write_sol_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, hm_ocp_qp_sol *sol, hm_real sc)
+{
+    const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
+    const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
+    int n, i, k, j;
+    for (i = 0; i < HM_NX; i++) sol->x[0][i] = qp->x0[i];
+    for (n = 0; n <= HM_N; n++) {
+        const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        if (n < HM_N) {
+            for (i = 0; i < HM_NU; i++) sol->u[n][i] = HM_R(0.0);
+            for (i = 0; i < HM_NX; i++) sol->pi[n][i] = -sc * sn->dy[i];
+        }
+        if (n > 0) {
+            for (i = 0; i < HM_NX; i++) sol->x[n][i] = HM_R(0.0);
+        }
+        for (i = 0; i < HM_NG; i++) {
+            sol->s[n][i] = HM_R(0.0);
+            sol->lam_lg[n][i] = HM_R(0.0);
+            sol->lam_ls[n][i] = HM_R(0.0);
+        }
+        for (i = 0; i < HM_NX; i++) {
+            sol->lam_lbx[n][i] = HM_R(0.0);
+            sol->lam_ubx[n][i] = HM_R(0.0);
+        }
+        if (n < HM_N) {
+            for (i = 0; i < HM_NU; i++) {
+                sol->lam_lbu[n][i] = HM_R(0.0);
+                sol->lam_ubu[n][i] = HM_R(0.0);
+            }
+        }
+        for (k = 0; k < bd->nbp; k++) {
+            const int c = bd->bc[k];
+            hm_real lo, up;
+            if (c < HM_NU ? n == HM_N : n == 0) continue;
+            lo = sc * bd->sg[k][0][n] * bd->sg[k][0][n] * OCP_QP_IPM_MAX(bd->dz[k][0][n], HM_R(0.0));
+            up = sc * bd->sg[k][1][n] * bd->sg[k][1][n] * OCP_QP_IPM_MAX(bd->dz[k][1][n], HM_R(0.0));
+            if (c < HM_NU) {
+                sol->lam_lbu[n][c] = lo;
+                sol->lam_ubu[n][c] = up;
+            } else {
+                sol->lam_lbx[n][c - HM_NU] = lo;
+                sol->lam_ubx[n][c - HM_NU] = up;
+            }
+        }
+        for (j = 0; j < sn->ns; j++) {
+            const int row = sn->soff + j;
+            const int i_row = sr->srow[row];
+            sol->s[n][i_row] = HM_R(0.0);
+            sol->lam_lg[n][i_row] = sc * OCP_QP_IPM_MAX(sr->sdz[row], HM_R(0.0));
+            sol->lam_ls[n][i_row] = sc * OCP_QP_IPM_MAX(sr->sdzs[row], HM_R(0.0));
+        }
+        for (j = 0; j < sn->nh; j++) sol->lam_lg[n][sn->hrow[j]] = sc * OCP_QP_IPM_MAX(sn->hdz[j], HM_R(0.0));
+    }
+}
+
+#ifdef HM_QP_POLISH
 /* The same from a vector in the solver's layout (the polished solution). */
 HM_FUNC void ocp_qp_ipm_write_sol_vec(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws,
                                       const hm_ocp_qp_ipm_vec *v, hm_ocp_qp_sol *sol, hm_real sc)
@@ -104,3 +162,4 @@ HM_FUNC void ocp_qp_ipm_write_sol_vec(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_w
                                v->s[n], v->zr[n], v->zs[n], v->zh[n], sc, HM_R(1.0));
     }
 }
+#endif

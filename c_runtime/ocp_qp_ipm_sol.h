@@ -12,8 +12,15 @@
 HM_FUNC void ocp_qp_ipm_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, hm_ocp_qp_sol *sol,
                                   hm_real sc, hm_real sp);
 
-/* The same from a vector in the solver's layout (the polished solution, a certificate). */
+/* sol := the certificate of ocp_qp_ipm_farkas_step (the last step's multiplier steps clipped at 0)
+ * scaled by sc (1 / -b'w); primal part zero but x_0 = x0. */
+HM_FUNC void ocp_qp_ipm_write_sol_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws, hm_ocp_qp_sol *sol,
+                                      hm_real sc);
+
+#ifdef HM_QP_POLISH
+/* The same as ocp_qp_ipm_write_sol from a vector in the solver's layout (the polished solution). */
 HM_FUNC void ocp_qp_ipm_write_sol_vec(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *ws,
                                       const hm_ocp_qp_ipm_vec *v, hm_ocp_qp_sol *sol, hm_real sc);
+#endif
 
 #endif /* OCP_QP_IPM_SOL_H */

@@ -22,9 +22,30 @@
  *   hard rows     D' p >= lg.
  * Rows are processed two at a time (2-wide SIMD where the compiler can); a stage with an odd count
  * pads its family with one neutral row (D = 0, state reset to 1, masked out of every sum).
- * The arrays below are sized HM_QP_NGP = HM_NG rounded up to even, written out since this file has
- * no include guard.
+ * The arrays below are sized by what a QP of this solver can have, written out since this file has no
+ * include guard (ocp_qp_kkt.h gives the code's names of the same sizes, ocp_qp_ipm_common.h checks
+ * that they agree):
+ *   HM_NBP   components of (u, x) that may be bounded (bound-pair slots); the QP layer's default is
+ *            all six, a generated solver's the OCP's three (HM_OCP_NBP: a, omega, v);
+ *   HM_NGH   hard rows a stage may have; default HM_NG, a generated solver's none (HM_OCP_NGH: every
+ *            distance row of the OCP is soft), which leaves one padding pair per stage;
+ *   HM_QP_POLISH  when defined, the active-set polish and the general solve of the Newton system
+ *            (ocp_qp_kkt.h) with their per-row weights and two vectors (the tests' QP builds); a
+ *            generated solver never polishes and leaves them out.
+ * A QP beyond these sizes is refused by the setup (HM_QP_NONFINITE: sizes out of range).
  * ---------------------------------------------------------------------------------------------- */
+#ifdef HM_NBP
+#define HM_TYPES_NBP_ (HM_NBP)
+#else
+#define HM_TYPES_NBP_ (HM_NU + HM_NX)
+#endif
+#ifdef HM_NGH
+#define HM_TYPES_NGHP_ (((HM_NGH) + 1) / 2 * 2 + ((HM_NGH) == 0) * 2)
+#else
+#define HM_TYPES_NGHP_ ((HM_NG + 1) / 2 * 2)
+#endif
+#define HM_TYPES_NNP_ ((HM_N + 8) / 8 * 8)
+
 
 /* One stage of the solver: its inequality families, its part of the iterate and of the direction,
  * and its part of the Newton system. Stage n carries (u_n, x_n) as one 6-vector ux (u first; u of
@@ -37,18 +58,18 @@ typedef struct HM_NS(ocp_qp_ipm_stage) {
     int a_id;                         /* 1: the first two columns of A_n are e_0, e_1 */
     int ab_int;                       /* 1: a_id, and rows 2 and 3 of [A_n B_n] are two integrators' (the
                                          robot's; ocp_qp_kkt.c: ocp_qp_kkt_factor_stage_integrators) */
-    unsigned char hrow[(HM_NG + 1) / 2 * 2];   /* QP row of hard row j */
+    unsigned char hrow[HM_TYPES_NGHP_];          /* QP row of hard row j */
     /* cost times the cost scale (stage 0: x_0 terms folded into q), dynamics offset (stage 0:
      * b_0 + A_0 x_0); column-major like ocp_qp */
     HM_REAL R[HM_NU * HM_NU], S[HM_NU * HM_NX], Q[HM_NX * HM_NX], q[HM_NU + HM_NX], beq[HM_NX];
 
     /* hard rows: -d' p + t = -lg */
-    HM_REAL hd0[(HM_NG + 1) / 2 * 2], hd1[(HM_NG + 1) / 2 * 2], hlg[(HM_NG + 1) / 2 * 2];
-    HM_REAL hlive[(HM_NG + 1) / 2 * 2];
-    HM_REAL ht[(HM_NG + 1) / 2 * 2], hz[(HM_NG + 1) / 2 * 2];
-    HM_REAL hdt[(HM_NG + 1) / 2 * 2], hdz[(HM_NG + 1) / 2 * 2];
-    HM_REAL hw[(HM_NG + 1) / 2 * 2], hti[(HM_NG + 1) / 2 * 2], hzi[(HM_NG + 1) / 2 * 2];
-    HM_REAL hdel[(HM_NG + 1) / 2 * 2];
+    HM_REAL hd0[HM_TYPES_NGHP_], hd1[HM_TYPES_NGHP_], hlg[HM_TYPES_NGHP_];
+    HM_REAL hlive[HM_TYPES_NGHP_];
+    HM_REAL ht[HM_TYPES_NGHP_], hz[HM_TYPES_NGHP_];
+    HM_REAL hdt[HM_TYPES_NGHP_], hdz[HM_TYPES_NGHP_];
+    HM_REAL hw[HM_TYPES_NGHP_], hti[HM_TYPES_NGHP_], hzi[HM_TYPES_NGHP_];
+    HM_REAL hdel[HM_TYPES_NGHP_];
 
     /* iterate and step of the stage; ry: right-hand side of the dynamics n -> n + 1 in the Newton
      * system (minus their residual) */
@@ -73,27 +94,27 @@ typedef struct HM_NS(ocp_qp_ipm_stage) {
  * rounded up to a multiple of 8 (HM_QP_NNP of ocp_qp_kkt.h), those past HM_N absent on both sides. */
 typedef struct HM_NS(ocp_qp_ipm_bounds) {
     int nbp;
-    unsigned char bc[HM_NU + HM_NX];
-    HM_REAL sg[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* sign */
-    HM_REAL b[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];
-    HM_REAL t[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];     /* slack */
-    HM_REAL z[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];     /* multiplier */
-    HM_REAL dt[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* step */
-    HM_REAL dz[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];
-    HM_REAL w[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];     /* z / t, capped */
-    HM_REAL ti[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* 1 / t */
-    HM_REAL zi[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];    /* 1 / z */
-    HM_REAL rho[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];   /* predictor right-hand side */
-    HM_REAL del[HM_NU + HM_NX][2][(HM_N + 8) / 8 * 8];   /* predictor dt dz */
+    unsigned char bc[HM_TYPES_NBP_];
+    HM_REAL sg[HM_TYPES_NBP_][2][HM_TYPES_NNP_];    /* sign */
+    HM_REAL b[HM_TYPES_NBP_][2][HM_TYPES_NNP_];
+    HM_REAL t[HM_TYPES_NBP_][2][HM_TYPES_NNP_];     /* slack */
+    HM_REAL z[HM_TYPES_NBP_][2][HM_TYPES_NNP_];     /* multiplier */
+    HM_REAL dt[HM_TYPES_NBP_][2][HM_TYPES_NNP_];    /* step */
+    HM_REAL dz[HM_TYPES_NBP_][2][HM_TYPES_NNP_];
+    HM_REAL w[HM_TYPES_NBP_][2][HM_TYPES_NNP_];     /* z / t, capped */
+    HM_REAL ti[HM_TYPES_NBP_][2][HM_TYPES_NNP_];    /* 1 / t */
+    HM_REAL zi[HM_TYPES_NBP_][2][HM_TYPES_NNP_];    /* 1 / z */
+    HM_REAL rho[HM_TYPES_NBP_][2][HM_TYPES_NNP_];   /* predictor right-hand side */
+    HM_REAL del[HM_TYPES_NBP_][2][HM_TYPES_NNP_];   /* predictor dt dz */
     /* per slot and stage: ux[c] of the iterate and of the step (pass C's predictor step until pass
      * E writes the corrector's); the pair's parts of the Newton diagonal and of the gradients ha,
      * hmu and hdl */
-    HM_REAL v[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
-    HM_REAL dv[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
-    HM_REAL Hd[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
-    HM_REAL hf[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
-    HM_REAL hmu[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
-    HM_REAL hdl[HM_NU + HM_NX][(HM_N + 8) / 8 * 8];
+    HM_REAL v[HM_TYPES_NBP_][HM_TYPES_NNP_];
+    HM_REAL dv[HM_TYPES_NBP_][HM_TYPES_NNP_];
+    HM_REAL Hd[HM_TYPES_NBP_][HM_TYPES_NNP_];
+    HM_REAL hf[HM_TYPES_NBP_][HM_TYPES_NNP_];
+    HM_REAL hmu[HM_TYPES_NBP_][HM_TYPES_NNP_];
+    HM_REAL hdl[HM_TYPES_NBP_][HM_TYPES_NNP_];
 } HM_NS(ocp_qp_ipm_bounds);
 
 /* The soft rows of all stages in one list: stage after stage, each stage's ns rows padded to an even
@@ -101,8 +122,11 @@ typedef struct HM_NS(ocp_qp_ipm_bounds) {
  * d = 0, at the neutral state s = t = z = zs = 1; HM_QP_NR of ocp_qp_kkt.h). Row r of stage n:
  * -(d' p + s) + t = -lg, s >= 0, cost zl s + Zl s^2 / 2 (times the cost scale). The passes of the
  * interior-point method run over the list eight rows at a time, with d' p and d' dp of each row's
- * stage in gp and gd. sdr, sdsb (from pass C to pass E) and se (the general solve's) are free in
- * pass A, which keeps its per-row terms there until the stages have summed them (ocp_qp_ipm_pass_a.c). */
+ * stage in gp and gd. What a pass derives from the iterate (the weights z / t, the inverses, the
+ * slack's stationarity residual) is not kept: passes C and E derive it again from the same numbers by
+ * the same expressions, which gives the same values for a few operations per present row (and the
+ * list only holds present rows). sdr, sdsb (from pass C to pass E) are free in pass A, which keeps
+ * its per-row terms there and in se until the stages have summed them (ocp_qp_ipm_pass_a.c). */
 /* one value per row of the list */
 typedef HM_REAL HM_NS(ocp_qp_ipm_row_vec)[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
 typedef struct HM_NS(ocp_qp_ipm_rows) {
@@ -112,16 +136,12 @@ typedef struct HM_NS(ocp_qp_ipm_rows) {
     HM_NS(ocp_qp_ipm_row_vec) ss, st;        /* slack s, row slack t */
     HM_NS(ocp_qp_ipm_row_vec) sz, szs;       /* multipliers of the row, of s >= 0 */
     HM_NS(ocp_qp_ipm_row_vec) sds, sdt, sdz, sdzs;
-    HM_NS(ocp_qp_ipm_row_vec) swr, sws;      /* weights z/t, zs/s */
-    HM_NS(ocp_qp_ipm_row_vec) shi;           /* 1 / (Zl + wr + ws) */
-    HM_NS(ocp_qp_ipm_row_vec) sti, szi;      /* 1/t, 1/z */
-    HM_NS(ocp_qp_ipm_row_vec) ssi, szsi;     /* 1/s, 1/zs */
-    HM_NS(ocp_qp_ipm_row_vec) srs;           /* stationarity residual of s */
     HM_NS(ocp_qp_ipm_row_vec) sdr, sdsb;     /* dt dz, ds dzs of the predictor */
-    HM_NS(ocp_qp_ipm_row_vec) se;            /* general solve: slack step at a zero position step */
+    HM_NS(ocp_qp_ipm_row_vec) se;            /* pass A's and C's per-row terms of the stage gradients */
     HM_NS(ocp_qp_ipm_row_vec) gp, gd;        /* d' p at the iterate's position, d' dp at the step's */
 } HM_NS(ocp_qp_ipm_rows);
 
+#ifdef HM_QP_POLISH
 /* A vector in the solver's layout (the Newton system's unknowns or right-hand side), used by the
  * general solve of ocp_qp_kkt.h (tests, polish): per stage ux, the soft slacks by soft row, y, and
  * one entry per inequality: bound lanes, soft rows, their s >= 0, hard rows. */
@@ -129,19 +149,31 @@ typedef struct HM_NS(ocp_qp_ipm_vec) {
     HM_REAL ux[HM_N + 1][HM_NU + HM_NX];
     HM_REAL s[HM_N + 1][(HM_NG + 1) / 2 * 2];
     HM_REAL y[HM_N][HM_NX];
-    HM_REAL zb[HM_N + 1][HM_NU + HM_NX][2];
+    HM_REAL zb[HM_N + 1][HM_TYPES_NBP_][2];
     HM_REAL zr[HM_N + 1][(HM_NG + 1) / 2 * 2];
     HM_REAL zs[HM_N + 1][(HM_NG + 1) / 2 * 2];
-    HM_REAL zh[HM_N + 1][(HM_NG + 1) / 2 * 2];
+    HM_REAL zh[HM_N + 1][HM_TYPES_NGHP_];
 } HM_NS(ocp_qp_ipm_vec);
 
+/* The general solve's weights of the soft rows (the bound sides' and the hard rows' are their
+ * families' w and hw), the slack steps of its condensation, and the polish's two vectors. */
+typedef struct HM_NS(ocp_qp_ipm_general) {
+    HM_NS(ocp_qp_ipm_row_vec) swr, sws;      /* weights of the row and of s >= 0 */
+    HM_NS(ocp_qp_ipm_row_vec) shi;           /* 1 / (Zl + wr + ws) */
+    HM_NS(ocp_qp_ipm_row_vec) se;            /* slack step at a zero position step */
+    HM_NS(ocp_qp_ipm_vec) va, vb;
+} HM_NS(ocp_qp_ipm_general);
+#endif
+
 /* An iterate kept by a solve for the next one's start (arg->warm_start, warm_mu): its slacks and
- * multipliers (unscaled) by stage and (u, x) component or QP row, so that the next QP may have
- * other bounds and rows. */
+ * multipliers (unscaled) by stage and bound slot (whose components bc are kept too) or QP row, so
+ * that the next QP may have other bounds and rows. */
 typedef struct HM_NS(ocp_qp_ipm_warm) {
     int ready;                                   /* 1: the last solve kept one */
-    HM_REAL bt[HM_N + 1][HM_NU + HM_NX][2];      /* bound sides (lower, upper): slack, 0 if absent */
-    HM_REAL bz[HM_N + 1][HM_NU + HM_NX][2];      /* and multiplier */
+    int nbp;                                     /* bound slots of the kept iterate, and their components */
+    unsigned char bc[HM_TYPES_NBP_];
+    HM_REAL bt[HM_N + 1][HM_TYPES_NBP_][2];      /* bound sides (lower, upper): slack, 0 if absent */
+    HM_REAL bz[HM_N + 1][HM_TYPES_NBP_][2];      /* and multiplier */
     HM_REAL rt[HM_N + 1][HM_NG], rz[HM_N + 1][HM_NG];     /* rows: slack, multiplier */
     HM_REAL rs[HM_N + 1][HM_NG], rzs[HM_N + 1][HM_NG];    /* soft rows: s, multiplier of s >= 0 */
     unsigned char kind[HM_N + 1][HM_NG];         /* 0 absent, 1 soft, 2 hard */
@@ -158,14 +190,21 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
     HM_REAL w_max;                    /* cap of the weights z / t (ocp_qp_ipm_setup.c) */
     HM_REAL norm_q, norm_b;
     int fallback;                     /* the solution came from the fallback solver (ocp_qp_hsde.h) */
-    /* the stages, and two vectors for the polish and the general solve; or the fallback's memory */
+    /* the stages and the families (and, with the polish, the general solve's memory); or the
+     * fallback's memory: the fallback starts from scratch, after the interior-point iteration */
     union {
         struct {
             HM_NS(ocp_qp_ipm_stage) st[HM_N + 1];
             HM_NS(ocp_qp_ipm_bounds) bd;
             HM_NS(ocp_qp_ipm_rows) sr;
-            HM_NS(ocp_qp_ipm_vec) va, vb;
+#ifdef HM_QP_POLISH
+            HM_NS(ocp_qp_ipm_general) gs;
+#endif
         } f;
         HM_NS(ocp_qp_hsde_ws) hsde;
     } u;
 } HM_NS(ocp_qp_ipm_ws);
+
+#undef HM_TYPES_NBP_
+#undef HM_TYPES_NGHP_
+#undef HM_TYPES_NNP_

@@ -24,7 +24,8 @@
 
 #define OCP_QP_IPM_WARM_FLOOR HM_R(0.02)
 
-/* Keep the iterate of pass A in ws->warm (multipliers unscaled: the next QP's scale may differ). */
+/* Keep the iterate of pass A in ws->warm (multipliers unscaled: the next QP's scale may differ), the
+ * bound sides by slot with the slots' components. */
 HM_FUNC void ocp_qp_ipm_warm_keep(hm_ocp_qp_ipm_ws *ws)
 {
     const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
@@ -32,17 +33,15 @@ HM_FUNC void ocp_qp_ipm_warm_keep(hm_ocp_qp_ipm_ws *ws)
     hm_ocp_qp_ipm_warm *w = &ws->warm;
     const hm_real cinv = HM_R(1.0) / ws->cost_scale;
     int n, k, l, j;
+    w->nbp = bd->nbp;
+    for (k = 0; k < bd->nbp; k++) w->bc[k] = bd->bc[k];
     for (n = 0; n <= HM_N; n++) {
         const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
-        for (k = 0; k < HM_QP_NUX; k++) {
-            w->bt[n][k][0] = w->bt[n][k][1] = HM_R(0.0);
-            w->bz[n][k][0] = w->bz[n][k][1] = HM_R(0.0);
-        }
         for (k = 0; k < bd->nbp; k++) {
             for (l = 0; l < 2; l++) {
-                if (bd->sg[k][l][n] == HM_R(0.0)) continue;
-                w->bt[n][bd->bc[k]][l] = bd->t[k][l][n];
-                w->bz[n][bd->bc[k]][l] = bd->z[k][l][n] * cinv;
+                const int present = bd->sg[k][l][n] != HM_R(0.0);
+                w->bt[n][k][l] = present ? bd->t[k][l][n] : HM_R(0.0);
+                w->bz[n][k][l] = present ? bd->z[k][l][n] * cinv : HM_R(0.0);
             }
         }
         for (j = 0; j < HM_NG; j++) w->kind[n][j] = 0;
@@ -70,23 +69,31 @@ HM_KERNEL hm_real ocp_qp_ipm_warm_floor(hm_real v)
 }
 
 /* Overwrite the cold start (ocp_qp_ipm_setup) with the kept iterate: stage n from kept stage
- * n + shift (the last stage from itself), wherever the kept stage has the same inequality. */
+ * n + shift (the last stage from itself), wherever the kept stage has the same inequality (a bound
+ * side of the same component, a row of the same index and kind). */
 HM_FUNC void ocp_qp_ipm_warm_apply(hm_ocp_qp_ipm_ws *ws, int shift)
 {
     hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
     const hm_ocp_qp_ipm_warm *w = &ws->warm;
     const hm_real c = ws->cost_scale;
-    int n, k, l, j;
+    int n, k, l, j, kept[HM_QP_NBP];
+    /* the kept slot of each slot's component, -1 if the kept iterate bounded it nowhere */
+    for (k = 0; k < bd->nbp; k++) {
+        kept[k] = -1;
+        for (j = 0; j < w->nbp; j++)
+            if (w->bc[j] == bd->bc[k]) kept[k] = j;
+    }
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
         const int m = n + shift <= HM_N ? n + shift : HM_N;
         for (k = 0; k < bd->nbp; k++) {
+            if (kept[k] < 0) continue;
             for (l = 0; l < 2; l++) {
-                const hm_real t = w->bt[m][bd->bc[k]][l];
+                const hm_real t = w->bt[m][kept[k]][l];
                 if (bd->sg[k][l][n] == HM_R(0.0) || !(t > HM_R(0.0))) continue;
                 bd->t[k][l][n] = ocp_qp_ipm_warm_floor(t);
-                bd->z[k][l][n] = ocp_qp_ipm_warm_floor(w->bz[m][bd->bc[k]][l] * c);
+                bd->z[k][l][n] = ocp_qp_ipm_warm_floor(w->bz[m][kept[k]][l] * c);
             }
         }
         for (j = 0; j < sn->ns; j++) {

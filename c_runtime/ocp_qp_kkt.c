@@ -336,6 +336,7 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp
     }
 }
 
+#ifdef HM_QP_POLISH
 /* ------------------------------------------------------------------------------------------------
  * The general system
  * ---------------------------------------------------------------------------------------------- */
@@ -343,7 +344,8 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *restrict qp, const hm_ocp
 HM_FUNC void ocp_qp_kkt_condense_weights(hm_ocp_qp_ipm_ws *ws)
 {
     const hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
-    hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
+    const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
+    hm_ocp_qp_ipm_general *gs = &ws->u.f.gs;
     int n, k, j;
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
@@ -359,10 +361,10 @@ HM_FUNC void ocp_qp_kkt_condense_weights(hm_ocp_qp_ipm_ws *ws)
             /* a soft row with weight wr, slack-bound weight ws and slack Hessian Zl acts like a hard
              * row of weight wr (Zl + ws) / (Zl + wr + ws) (the two in series; as a product, not as
              * wr - wr^2 / (...), which cancels when wr is large) */
-            const hm_real hinv = HM_R(1.0) / (sr->sZl[row] + sr->swr[row] + sr->sws[row]);
-            const hm_real we = sr->swr[row] * (sr->sZl[row] + sr->sws[row]) * hinv;
+            const hm_real hinv = HM_R(1.0) / (sr->sZl[row] + gs->swr[row] + gs->sws[row]);
+            const hm_real we = gs->swr[row] * (sr->sZl[row] + gs->sws[row]) * hinv;
             const hm_real wd0 = we * sr->sd0[row];
-            sr->shi[row] = hinv;
+            gs->shi[row] = hinv;
             h00 += wd0 * sr->sd0[row];
             h10 += wd0 * sr->sd1[row];
             h11 += we * sr->sd1[row] * sr->sd1[row];
@@ -391,7 +393,8 @@ HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws)
 
 /* Gradient of the condensed stage QP for a general right-hand side: h = -(rhs_v + A_I' W rhs_z)
  * with the soft slacks folded in (their step at a zero position step into e). */
-HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd, hm_ocp_qp_ipm_rows *sr,
+HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd,
+                                 const hm_ocp_qp_ipm_rows *sr, hm_ocp_qp_ipm_general *gs,
                                  const hm_ocp_qp_ipm_vec *rhs, int n, hm_real *h)
 {
     hm_real hp0 = HM_R(0.0), hp1 = HM_R(0.0);
@@ -404,10 +407,10 @@ HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bo
     }
     for (j = 0; j < sn->ns; j++) {
         const int row = sn->soff + j;
-        hm_real coef = sr->swr[row] * rhs->zr[n][j];
-        const hm_real ej = (rhs->s[n][j] - coef - sr->sws[row] * rhs->zs[n][j]) * sr->shi[row];
-        sr->se[row] = ej;
-        coef += sr->swr[row] * ej;
+        hm_real coef = gs->swr[row] * rhs->zr[n][j];
+        const hm_real ej = (rhs->s[n][j] - coef - gs->sws[row] * rhs->zs[n][j]) * gs->shi[row];
+        gs->se[row] = ej;
+        coef += gs->swr[row] * ej;
         hp0 += coef * sr->sd0[row];
         hp1 += coef * sr->sd1[row];
     }
@@ -423,8 +426,8 @@ HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bo
 /* dz of the inequalities of stage n and the soft slack steps, from the (u, x) step of the stage.
  * Reads each entry of rhs before it writes the same entry of sol, so the two may be one vector. */
 HM_FUNC void ocp_qp_kkt_expand(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bounds *bd,
-                               const hm_ocp_qp_ipm_rows *sr, const hm_ocp_qp_ipm_vec *rhs, hm_ocp_qp_ipm_vec *sol,
-                               int n)
+                               const hm_ocp_qp_ipm_rows *sr, const hm_ocp_qp_ipm_general *gs,
+                               const hm_ocp_qp_ipm_vec *rhs, hm_ocp_qp_ipm_vec *sol, int n)
 {
     const hm_real *dux = sol->ux[n];
     const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
@@ -436,11 +439,11 @@ HM_FUNC void ocp_qp_kkt_expand(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ip
     for (j = 0; j < sn->ns; j++) {
         const int row = sn->soff + j;
         hm_real gd = -(sr->sd0[row] * dp0 + sr->sd1[row] * dp1);
-        const hm_real dsl = sr->se[row] + sr->swr[row] * sr->shi[row] * gd;
+        const hm_real dsl = gs->se[row] + gs->swr[row] * gs->shi[row] * gd;
         sol->s[n][j] = dsl;
-        sol->zs[n][j] = sr->sws[row] * (-dsl - rhs->zs[n][j]);
+        sol->zs[n][j] = gs->sws[row] * (-dsl - rhs->zs[n][j]);
         gd -= dsl;
-        sol->zr[n][j] = sr->swr[row] * (gd - rhs->zr[n][j]);
+        sol->zr[n][j] = gs->swr[row] * (gd - rhs->zr[n][j]);
     }
     for (j = 0; j < sn->nh; j++) {
         const hm_real gd = -(sn->hd0[j] * dp0 + sn->hd1[j] * dp1);
@@ -455,7 +458,7 @@ HM_FUNC void ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const h
     for (n = HM_N; n >= 0; n--) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
         hm_real h[HM_QP_NUX];
-        ocp_qp_kkt_condense(sn, &ws->u.f.bd, &ws->u.f.sr, rhs, n, h);
+        ocp_qp_kkt_condense(sn, &ws->u.f.bd, &ws->u.f.sr, &ws->u.f.gs, rhs, n, h);
         if (n < HM_N) {
             for (i = 0; i < HM_NX; i++) sn->ry[i] = rhs->y[n][i];
             ocp_qp_kkt_mv4(ws->u.f.st[n + 1].P, sn->ry, sn->Pry);
@@ -472,8 +475,9 @@ HM_FUNC void ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const h
             sol->ux[n + 1][HM_NU + i] = xn[i];
             sol->y[n][i] = dy[i];
         }
-        ocp_qp_kkt_expand(&ws->u.f.st[n], &ws->u.f.bd, &ws->u.f.sr, rhs, sol, n);
+        ocp_qp_kkt_expand(&ws->u.f.st[n], &ws->u.f.bd, &ws->u.f.sr, &ws->u.f.gs, rhs, sol, n);
     }
     for (i = 0; i < HM_NU; i++) sol->ux[HM_N][i] = HM_R(0.0);
-    ocp_qp_kkt_expand(&ws->u.f.st[HM_N], &ws->u.f.bd, &ws->u.f.sr, rhs, sol, HM_N);
+    ocp_qp_kkt_expand(&ws->u.f.st[HM_N], &ws->u.f.bd, &ws->u.f.sr, &ws->u.f.gs, rhs, sol, HM_N);
 }
+#endif /* HM_QP_POLISH */

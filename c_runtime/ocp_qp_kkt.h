@@ -36,6 +36,20 @@
 #define HM_QP_NGP ((HM_NG + 1) / 2 * 2)
 /* the soft rows of all stages, each stage padded to even, the list to a multiple of 8 */
 #define HM_QP_NR (((HM_N + 1) * HM_QP_NGP + 7) / 8 * 8)
+/* components of (u, x) that may be bounded (bound-pair slots) and hard rows a stage may have: the
+ * solver's HM_NBP and HM_NGH, by default all (ocp_qp_ipm_types.h); hard-row slots per stage, rounded
+ * up to even and at least one pair */
+#ifdef HM_NBP
+#define HM_QP_NBP (HM_NBP)
+#else
+#define HM_QP_NBP HM_QP_NUX
+#endif
+#ifdef HM_NGH
+#define HM_QP_NGH (HM_NGH)
+#else
+#define HM_QP_NGH HM_NG
+#endif
+#define HM_QP_NGHP ((HM_QP_NGH + 1) / 2 * 2 + (HM_QP_NGH == 0) * 2)
 
 /* The 2x2 input block and the (px, py) rows are written out for these sizes. */
 typedef char ocp_qp_kkt_sizes_fixed[(HM_NU == 2 && HM_NX == 4 && HM_NP == 2 && HM_NG <= 255) ? 1 : -1];
@@ -62,8 +76,10 @@ HM_FUNC void ocp_qp_kkt_forward_stage(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_s
                                       const hm_ocp_qp_ipm_stage *sn1, int n, const hm_real *x, hm_real *u,
                                       hm_real *xn, hm_real *dy);
 
-/* General system. ocp_qp_kkt_condense_weights: sn->Hd, sn->Hpp and the soft rows' 1 / (Zl + wr + ws)
- * from the weights in the stage blocks. ocp_qp_kkt_factorize: all stages. 0 or HM_QP_NUMERICAL. */
+#ifdef HM_QP_POLISH
+/* General system (built with HM_QP_POLISH). ocp_qp_kkt_condense_weights: sn->Hd, sn->Hpp and the soft
+ * rows' 1 / (Zl + wr + ws) from the weights in the bound pairs (w), the general solve's soft-row
+ * weights (ws->u.f.gs) and the hard rows (hw). ocp_qp_kkt_factorize: all stages. 0 or HM_QP_NUMERICAL. */
 HM_FUNC void ocp_qp_kkt_condense_weights(hm_ocp_qp_ipm_ws *ws);
 HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws);
 
@@ -71,6 +87,7 @@ HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws);
  * blocks' ry, p, yk as scratch. */
 HM_FUNC void ocp_qp_kkt_solve(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, const hm_ocp_qp_ipm_vec *rhs,
                               hm_ocp_qp_ipm_vec *sol);
+#endif
 
 /* 4x4 kernels of the recursion that the fallback solver and the interior-point method use too, inline
  * as in the recursion. F = P M for the symmetric 4x4 P (stored in full) and the 4 x ncol matrix M,

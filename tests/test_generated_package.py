@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -173,6 +174,16 @@ def test_cli_generate_then_build(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert cli.main(["info", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "N=8 intervals" in printed and "cli_robot_dynamics(x, u) -> x_next, A, B" in printed
+    # the solver's memory, by part: they add up to the struct (the fallback shares the workspace's union)
+    sized = (re.fullmatch(r"\s*(.*?)\s+([\d,]+) B", ln) for ln in printed.splitlines())
+    lines = {m.group(1): int(m.group(2).replace(",", "")) for m in sized if m}
+    total = lines["cli_robot_solver"]
+    top = [v for k, v in lines.items() if k in ("QP data (ocp_qp)", "QP solution = NLP multipliers (ocp_qp_sol)",
+                                                "QP warm start (kept iterate)",
+                                                "QP workspace (interior point | fallback)", "row screening",
+                                                "iterate, parameters, the rest")]
+    assert len(top) == 6 and sum(top) == total, lines
+    assert lines["fallback (shares the above)"] <= lines["QP workspace (interior point | fallback)"]
 
 
 @pytest.mark.parametrize("command", [[], ["check"], ["generate"], ["build"], ["info"], ["keys"], ["bench"],

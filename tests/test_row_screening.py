@@ -41,6 +41,7 @@ def test_every_screened_rti_qp_solution_solves_the_whole_qp(crowd_dir: Path, tmp
     r = json.loads(proc.stdout.strip().splitlines()[-1])
     assert r["checked"] >= 150
     assert r["resolves"] >= 1  # the path that admits violated rows and solves again was taken
+    assert r["far_rows"] >= 1  # rows the linearisation left unevaluated (beyond the radius), checked too
     assert r["obj_rel"] <= 1e-5  # the QP tolerance is 1e-6 (scaled); both are solutions to it
     assert r["ineq"] <= 1e-8  # no row of the whole QP is violated at the screened solution
     assert r["stat"] <= max(1e-6, 100 * r["stat_full"])

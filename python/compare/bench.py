@@ -233,6 +233,8 @@ def bench_spec(base: Spec, k: int) -> Spec:
     data = base.to_dict()
     data["name"] = f"bench_h{k}"
     data["humans"]["max"] = k
+    # the controller takes at least the solver's N_h tracks (the spec's rule): room for a crowd of k
+    data["controller"]["max_tracks"] = max(int(data["controller"]["max_tracks"]), k)
     return resolve_spec(data)
 
 

@@ -14,7 +14,7 @@ from ..codegen.spec import SpecError, load_spec
 from ..status import OUTCOME_NAMES, STOP_REASONS
 from .controller import DEADLINE_PROBE_MS, ControllerAgreement, ControllerRun, run_controller_firmware
 from .image import CPUS, FirmwareError, image_size, load_replay_file, run_firmware
-from .report import footprint_report, report_markdown
+from .report import ControllerRow, controller_markdown, footprint_report, report_markdown
 
 
 def _cmd_firmware(args: argparse.Namespace) -> int:
@@ -92,16 +92,24 @@ def _cmd_report(args: argparse.Namespace) -> int:
     if bad:
         raise SpecError([f"unknown CPU or precision {b!r}: CPUs {', '.join(CPUS)}; precisions double, float"
                          for b in bad], "firmware-report")
+    controller_rows: list[ControllerRow] = []
+    ram_bytes = args.ram_kib * 1024 if args.ram_kib else None
     try:
         rows = footprint_report(load_spec(args.spec), humans, cpus, precisions, steps=args.steps, out_dir=args.out,
-                                seed=args.seed)
+                                seed=args.seed, controller_steps=args.controller_steps, ram_bytes=ram_bytes,
+                                controller_rows=controller_rows)
     except FirmwareError as err:
         print(f"humanmpc-gen: {err}", file=sys.stderr)
         return 1
     table = report_markdown(rows)
+    if controller_rows:
+        table += ("\nThe navigation controller's replay image (<name>_controller_step over a recorded closed "
+                  "loop)" + (f", linked into {args.ram_kib} KiB of RAM" if ram_bytes else "") + ":\n\n"
+                  + controller_markdown(controller_rows))
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "firmware_report.md").write_text(table)
-    (args.out / "firmware_report.json").write_text(json.dumps([asdict(r) for r in rows], indent=2) + "\n")
+    (args.out / "firmware_report.json").write_text(json.dumps(
+        {"solver": [asdict(r) for r in rows], "controller": [asdict(r) for r in controller_rows]}, indent=2) + "\n")
     print(table, end="")
     print(f"(written to {args.out / 'firmware_report.md'} and .json)")
     return 0
@@ -140,12 +148,20 @@ def add_firmware_parser(subparsers: Any) -> None:
         "firmware-report", help="footprint and instruction counts over N_h, CPUs and precisions",
         description="Generate one solver per N_h and precision (from SPEC or the default spec), cross-compile "
         "the footprint and replay programs for each CPU, run the replays under QEMU and print the table of "
-        "flash, RAM and instructions per RTI step (QEMU icount: instructions, not cycles).")
+        "flash, RAM and instructions per RTI step (QEMU icount: instructions, not cycles) with the agreement "
+        "with the host library; with --controller-steps the same for the navigation controller's replay image, "
+        "optionally linked into the RAM of a smaller part (--ram-kib).")
     p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
     p.add_argument("--humans", default="5,10,30", help="N_h values (default 5,10,30)")
     p.add_argument("--cpus", default="cortex-m4,cortex-m7", help="CPUs (default cortex-m4,cortex-m7)")
     p.add_argument("--precisions", default="double,float", help="precisions (default double,float)")
     p.add_argument("--steps", type=int, default=20, help="replay steps per run (default 20)")
     p.add_argument("--seed", type=non_negative_int, default=0, help="seed of the recorded crowds (default 0)")
+    p.add_argument("--controller-steps", type=non_negative_int, default=0,
+                   help="also replay a recorded controller closed loop of this many periods per row (its image's RAM "
+                   "with the stack, flash, instructions per period, agreement with the host; default 0: none)")
+    p.add_argument("--ram-kib", type=non_negative_int, default=0,
+                   help="link the controller images into this much RAM (KiB; the stack at its top), e.g. 192 for an "
+                   "STM32F405: an image that does not fit fails to link (default 0: the board's 4 MiB)")
     p.add_argument("--out", type=output_dir, default=Path("out/firmware"), help="output folder (default out/firmware)")
     p.set_defaults(func=_cmd_report)

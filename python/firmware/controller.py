@@ -542,10 +542,11 @@ def compare_controller(run: ControllerRun, host: Sequence[ControllerResult], par
 
 def run_controller_firmware(solver_dir: str | Path, cpu: str, replay: ControllerReplay | None = None, *,
                             steps: int = 140, seed: int = 0, cold: bool = False, timeout: float = 600.0,
-                            log: Callable[[str], None] | None = None) -> \
+                            ram_bytes: int | None = None, log: Callable[[str], None] | None = None) -> \
         tuple[ControllerRun, ControllerAgreement, Path, ControllerReplay]:
     """Record (or take) a controller replay, build and run it on cpu, compare with the host library of
-    the same package; (run, agreement, elf, replay)."""
+    the same package; (run, agreement, elf, replay). ram_bytes: the image linked into that much RAM
+    (build_firmware)."""
     say = log or print_progress
     d = Path(solver_dir).resolve()
     require_tools()
@@ -555,7 +556,7 @@ def run_controller_firmware(solver_dir: str | Path, cpu: str, replay: Controller
         replay = record_controller_replay(host, steps=steps, seed=seed)
     fw = write_controller_firmware(d, replay, cold=cold)
     say(f"[humanmpc] cross-compiling the controller replay in {fw} for {cpu}")
-    elf = build_firmware(fw, cpu, "controller")
+    elf = build_firmware(fw, cpu, "controller", ram_bytes=ram_bytes)
     say(f"[humanmpc] running {elf.name} under qemu-system-arm -M {CPUS[cpu].machine} -icount shift=0")
     t0 = time.perf_counter()
     run = parse_controller_output(run_qemu(elf, cpu, timeout=timeout))

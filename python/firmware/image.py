@@ -287,16 +287,19 @@ def write_firmware(solver_dir: str | Path, replay: Replay, *, cold: bool = False
     return out
 
 
-def build_firmware(fw_dir: Path, cpu: str, target: str = "replay") -> Path:
-    """Cross-compile one program ("replay" or "footprint") of fw_dir for cpu; return the ELF."""
+def build_firmware(fw_dir: Path, cpu: str, target: str = "replay", *, ram_bytes: int | None = None) -> Path:
+    """Cross-compile one program ("replay" or "footprint") of fw_dir for cpu; return the ELF. ram_bytes:
+    link it into that much RAM (the stack at its top) instead of the board's 4 MiB; an image that does
+    not fit fails with the linker's message."""
     cpu_target(cpu)
     tools = require_tools()
-    proc = subprocess.run([tools["make"], "-C", str(fw_dir), "--no-print-directory", f"CPU={cpu}", target],
+    ram = [f"RAM_BYTES={ram_bytes}"] if ram_bytes else []
+    proc = subprocess.run([tools["make"], "-C", str(fw_dir), "--no-print-directory", f"CPU={cpu}", *ram, target],
                           capture_output=True, text=True, check=False)
     if proc.returncode != 0:
         tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-40:])
         raise FirmwareError(f"cross-compiling {fw_dir} for {cpu} failed (make exit {proc.returncode}):\n{tail}")
-    return fw_dir / "build" / cpu / f"{target}.elf"
+    return fw_dir / "build" / (f"{cpu}-ram{ram_bytes}" if ram_bytes else cpu) / f"{target}.elf"
 
 
 def run_qemu(elf: Path, cpu: str, *, timeout: float = 600.0) -> str:

@@ -4,7 +4,7 @@
  *
  * Build: cc -DSOLVER_HEADER='"soak.h"' -DSOLVER_PREFIX=soak_ -I<dir> closed_loop.c <dir>/soak.c
  *        <dir>/soak_model.c -lm
- * Run:   ./closed_loop STEPS SEED DEADLINE_MS [fixed]
+ * Run:   ./closed_loop STEPS SEED DEADLINE_MS [fixed]   (build with -DDT=T/N for a spec whose interval is not 0.1 s)
  * With "fixed", all N_h humans are present at every step and nothing is injected: the workload of
  * the benchmark's crowds, for instruction counts (valgrind --tool=callgrind; docs/benchmarks.md).
  * Every step: the command is finite; a stop has a reason and no other step has one; whenever the
@@ -30,7 +30,11 @@
 
 #define NH_ALLOC ((int)(sizeof(((S(input) *)0)->humans_now) / sizeof(((S(input) *)0)->humans_now[0])))
 #define NNODES ((int)(sizeof(((S(output) *)0)->x) / sizeof(((S(output) *)0)->x[0])))
+/* The period of the loop: one shooting interval (the RTI shifts its plan by one per step), and the
+ * predictions' node spacing. Give the solver's T / N with -DDT=... when it is not 0.1 s. */
+#ifndef DT
 #define DT 0.1
+#endif
 #define MAX_REASONS 32 /* the table has n_reasons rows (counted at start, by their messages) */
 
 #ifdef OCP_QP_IPM_PROFILE
@@ -58,7 +62,7 @@ static double uniform(double lo, double hi)
     return lo + (hi - lo) * (double)(rng_state >> 11) / 9007199254740992.0;
 }
 
-static double pos[64][2], vel[64][2];
+static double pos[NH_ALLOC][2], vel[NH_ALLOC][2];
 
 static void spawn(int j, const double *robot)
 {
@@ -103,7 +107,6 @@ int main(int argc, char **argv)
     unsigned long long xu_hash = 1469598103934665603ULL; /* FNV-1a of x and u at every step: bit-identity checks */
     double total_ms = 0.0, prepare_ms = 0.0;
     rng_state = (unsigned long long)(argc > 2 ? atol(argv[2]) : 1) * 2654435761ULL + 1ULL;
-    if (NH_ALLOC > 64) return 100;
     while (n_reasons < MAX_REASONS && strcmp(S(stop_reason_message)(n_reasons), "unknown stop reason") != 0) n_reasons++;
     S(solver_init)(&solver);
     S(solver_params)(&solver)->deadline_ms = deadline_ms;
@@ -211,6 +214,6 @@ int main(int argc, char **argv)
 #ifdef OCP_QP_IPM_PROFILE
     for (j = 0; j < 7; j++) printf(", \"%s_us\": %.3f", profile_parts[j], 1e-3 * ocp_qp_ipm_profile_ns[j] / (double)steps);
 #endif
-    printf(", \"xu_hash\": \"%016llx\"}\n", xu_hash);
+    printf(", \"solver_bytes\": %lu, \"xu_hash\": \"%016llx\"}\n", (unsigned long)sizeof solver, xu_hash);
     return violations > 100 ? 100 : (int)violations;
 }

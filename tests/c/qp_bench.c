@@ -18,6 +18,7 @@
  */
 #define _POSIX_C_SOURCE 199309L
 #define HM_REAL double
+#define HM_QP_POLISH /* the polish and the general solve too (ocp_qp_ipm_types.h) */
 #define HM_NS(x) HM_CONCAT(qpb_, x)
 #define HM_N QPB_N
 #define HM_NG QPB_NG

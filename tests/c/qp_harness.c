@@ -10,6 +10,8 @@
 #else
 #define HM_REAL double
 #endif
+/* the tests' QP build: with the active-set polish and the general solve (ocp_qp_ipm_types.h) */
+#define HM_QP_POLISH
 #define HM_NS(x) HM_CONCAT(qpt_, x)
 #define HM_N QPT_N
 #define HM_NG QPT_NG
@@ -228,7 +230,7 @@ int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
     int kind[HM_NG], fam[HM_NG];
     hm_ocp_qp_ipm_vec *v = &g_vec;
     hm_ocp_qp_ipm_bounds *bd = &g_ws.u.f.bd;
-    hm_ocp_qp_ipm_rows *sr = &g_ws.u.f.sr;
+    hm_ocp_qp_ipm_general *gs = &g_ws.u.f.gs;
     if (ocp_qp_ipm_setup(&g_qp, &g_ws, &bad)) return HM_QP_INFEASIBLE;
     memset(v, 0, sizeof *v);
     for (n = 0; n <= HM_N; n++) {
@@ -249,7 +251,7 @@ int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
         qp_harness_row_map(n, kind, fam);
         for (k = 0; k < sn->ns + sn->nh; k++) {
             if (kind[k]) {
-                sr->swr[sn->soff + fam[k]] = w[pos];
+                gs->swr[sn->soff + fam[k]] = w[pos];
                 v->zr[n][fam[k]] = rhs[off_z + pos];
                 v->s[n][fam[k]] = rhs[off_s + n * HM_NG + k];
             } else {
@@ -259,7 +261,7 @@ int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
             pos++;
         }
         for (j = 0; j < sn->ns; j++) {
-            sr->sws[sn->soff + j] = w[pos];
+            gs->sws[sn->soff + j] = w[pos];
             v->zs[n][j] = rhs[off_z + pos];
             pos++;
         }

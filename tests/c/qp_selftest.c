@@ -13,6 +13,7 @@
 #define HM_REAL double
 #define TOL_RES 1e-6
 #endif
+#define HM_QP_POLISH /* the polish and the general solve too (ocp_qp_ipm_types.h) */
 #define HM_NS(x) HM_CONCAT(qps_, x)
 #define HM_N 8
 #define HM_NG 4
