@@ -108,68 +108,100 @@ HM_FUNC hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2)
 }
 
 /* Symmetric n x n M (column-major, n <= 6) replaced by its projection onto {eigenvalues >= floor}:
- * cyclic Jacobi rotations, then V max(Lambda, floor) V'. When M is block diagonal, rows and columns
- * [0, nb) and [nb, n) (nb = n when it is not), the rotations and products are those of the blocks
- * alone: a rotation of a pair within one block leaves the other block's entries of its two rows and
- * columns at exactly +0 (c * 0 - s * 0, s * 0 + c * 0), so the pairs across blocks are skipped by the
- * full sweep's own test (m_ij == 0) and the products with those zeros change no sum. The same
- * numbers, in about half the instructions for the robot's stages (ocp_nlp_convexify_stage). */
-static void ocp_nlp_project_psd(hm_real *M, int n, int nb, hm_real floor)
+ * cyclic Jacobi rotations on the upper triangle (each rotation zeroes its pair and moves the other
+ * rows' two entries; Golub and Van Loan 8.5), then V max(Lambda, floor) V'. When every eigenvalue is
+ * at least floor the projection is M itself, which is kept as it was: rebuilding it from V and
+ * Lambda would only add rounding. */
+static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
 {
-    hm_real V[36], off, total = HM_R(0.0);
-    int i, j, k, sweep;
+    hm_real A[36], V[36], off, total = HM_R(0.0);
+    int i, j, k, sweep, clipped = 0;
     for (i = 0; i < n * n; i++) {
+        A[i] = M[i];
         V[i] = HM_R(0.0);
         total += M[i] * M[i];
     }
     for (i = 0; i < n; i++) V[i + i * n] = HM_R(1.0);
     for (sweep = 0; sweep < 30; sweep++) {
         off = HM_R(0.0);
-        for (i = 0; i < n; i++)
-            for (j = i + 1; j < n; j++) off += M[i + j * n] * M[i + j * n];
+        for (j = 1; j < n; j++)
+            for (i = 0; i < j; i++) off += A[i + j * n] * A[i + j * n];
         if (off <= HM_EPS * HM_EPS * total) break;
-        for (i = 0; i < n; i++) {
-            /* the block of row i: its pairs, and the rows and columns a rotation of them touches */
-            const int lo = i < nb ? 0 : nb, hi = i < nb ? nb : n;
-            for (j = i + 1; j < hi; j++) {
-                const hm_real mij = M[i + j * n];
-                hm_real theta, t, c, sn;
-                if (mij == HM_R(0.0)) continue;
-                theta = (M[j + j * n] - M[i + i * n]) / (HM_R(2.0) * mij);
+        for (i = 0; i < n; i++)
+            for (j = i + 1; j < n; j++) {
+                const hm_real aij = A[i + j * n];
+                hm_real theta, t, c, sn, tau;
+                if (aij == HM_R(0.0)) continue;
+                theta = (A[j + j * n] - A[i + i * n]) / (HM_R(2.0) * aij);
                 t = (theta >= HM_R(0.0) ? HM_R(1.0) : HM_R(-1.0)) / (hm_fabs(theta) + hm_sqrt(theta * theta + HM_R(1.0)));
                 c = HM_R(1.0) / hm_sqrt(t * t + HM_R(1.0));
                 sn = t * c;
-                for (k = lo; k < hi; k++) { /* M <- M J */
-                    const hm_real a = M[k + i * n], b = M[k + j * n];
-                    M[k + i * n] = c * a - sn * b;
-                    M[k + j * n] = sn * a + c * b;
-                }
-                for (k = lo; k < hi; k++) { /* M <- J' M */
-                    const hm_real a = M[i + k * n], b = M[j + k * n];
-                    M[i + k * n] = c * a - sn * b;
-                    M[j + k * n] = sn * a + c * b;
-                }
-                for (k = lo; k < hi; k++) { /* V <- V J */
-                    const hm_real a = V[k + i * n], b = V[k + j * n];
-                    V[k + i * n] = c * a - sn * b;
-                    V[k + j * n] = sn * a + c * b;
+                tau = sn / (HM_R(1.0) + c);
+                A[i + i * n] -= t * aij;
+                A[j + j * n] += t * aij;
+                A[i + j * n] = A[j + i * n] = HM_R(0.0);
+                for (k = 0; k < n; k++) {
+                    hm_real g, h;
+                    if (k != i && k != j) {
+                        g = A[k + i * n];
+                        h = A[k + j * n];
+                        A[k + i * n] = A[i + k * n] = g - sn * (h + g * tau);
+                        A[k + j * n] = A[j + k * n] = h + sn * (g - h * tau);
+                    }
+                    g = V[k + i * n];
+                    h = V[k + j * n];
+                    V[k + i * n] = g - sn * (h + g * tau);
+                    V[k + j * n] = h + sn * (g - h * tau);
                 }
             }
-        }
     }
     {
         hm_real lam[6];
-        for (k = 0; k < n; k++) lam[k] = hm_fmax(M[k + k * n], floor);
-        for (i = 0; i < n; i++) {
-            const int lo = i < nb ? 0 : nb, hi = i < nb ? nb : n;
-            for (j = 0; j < n; j++) {
-                hm_real acc = HM_R(0.0);
-                if (j >= lo && j < hi)
-                    for (k = lo; k < hi; k++) acc += V[i + k * n] * lam[k] * V[j + k * n];
-                M[i + j * n] = acc;
+        for (k = 0; k < n; k++) {
+            lam[k] = A[k + k * n];
+            if (lam[k] < floor) {
+                lam[k] = floor;
+                clipped = 1;
             }
         }
+        if (!clipped) return;
+        for (j = 0; j < n; j++)
+            for (i = 0; i <= j; i++) {
+                hm_real acc = HM_R(0.0);
+                for (k = 0; k < n; k++) acc += V[i + k * n] * lam[k] * V[j + k * n];
+                M[i + j * n] = M[j + i * n] = acc;
+            }
     }
+}
+
+/* The 2 x 2 case in closed form: [a b; b c] projected onto {eigenvalues >= floor}. Its smaller
+ * eigenvalue lo = (a + c) / 2 - r, r = sqrt(((c - a) / 2)^2 + b^2), with eigenvector u: the
+ * projection adds (floor - lo) u u' when only lo is below floor, and is floor I when both are. */
+static void ocp_nlp_project_psd2(hm_real *a, hm_real *b, hm_real *c, hm_real floor)
+{
+    const hm_real hd = HM_R(0.5) * (*c - *a);
+    const hm_real r = hm_sqrt(hd * hd + *b * *b);
+    const hm_real mean = HM_R(0.5) * (*a + *c);
+    const hm_real lo = mean - r;
+    hm_real u0, u1, scale;
+    if (lo >= floor) return;
+    if (mean + r <= floor) {
+        *a = *c = floor;
+        *b = HM_R(0.0);
+        return;
+    }
+    /* (M - lo I) u = 0 from the row with the larger diagonal entry: r - hd or r + hd, no cancellation */
+    if (hd >= HM_R(0.0)) {
+        u0 = -(r + hd);
+        u1 = *b;
+    } else {
+        u0 = *b;
+        u1 = -(r - hd);
+    }
+    scale = (floor - lo) / (u0 * u0 + u1 * u1);
+    *a += scale * u0 * u0;
+    *b += scale * u0 * u1;
+    *c += scale * u1 * u1;
 }
 
 /* Stage n's Hessian blocks [Q S'; S R] (or Q alone at n = N) projected onto the PSD cone. */
@@ -177,7 +209,7 @@ static void ocp_nlp_convexify_stage(hm_ocp_qp *qp, int n, hm_real floor)
 {
     hm_real M[36];
     const int nz = n < HM_N ? HM_NX + HM_NU : HM_NX;
-    int i, j, nb = 2;
+    int i, j, blocks = 1;
     for (j = 0; j < HM_NX; j++)
         for (i = 0; i < HM_NX; i++) M[i + j * nz] = qp->Q[n][i + j * HM_NX];
     if (n < HM_N) {
@@ -190,11 +222,24 @@ static void ocp_nlp_convexify_stage(hm_ocp_qp *qp, int n, hm_real floor)
             for (i = 0; i < HM_NU; i++) M[HM_NX + i + (HM_NX + j) * nz] = qp->R[n][i + j * HM_NU];
     }
     /* the robot's stages are block diagonal, (px, py) apart from (theta, v, a, omega): the dynamics'
-     * Hessian has no position in it. Checked; the full matrix otherwise. */
+     * Hessian has no position in it, and the projection of a block diagonal matrix is that of its
+     * blocks. Checked; the full matrix otherwise. */
     for (j = 0; j < 2; j++)
         for (i = 2; i < nz; i++)
-            if (M[i + j * nz] != HM_R(0.0) || M[j + i * nz] != HM_R(0.0)) nb = nz;
-    ocp_nlp_project_psd(M, nz, nb, floor);
+            if (M[i + j * nz] != HM_R(0.0) || M[j + i * nz] != HM_R(0.0)) blocks = 0;
+    if (blocks) {
+        hm_real B[36];
+        const int nr = nz - 2;
+        ocp_nlp_project_psd2(&M[0], &M[nz], &M[1 + nz], floor);
+        M[1] = M[nz];
+        for (j = 0; j < nr; j++)
+            for (i = 0; i < nr; i++) B[i + j * nr] = M[2 + i + (2 + j) * nz];
+        ocp_nlp_project_psd(B, nr, floor);
+        for (j = 0; j < nr; j++)
+            for (i = 0; i < nr; i++) M[2 + i + (2 + j) * nz] = B[i + j * nr];
+    } else {
+        ocp_nlp_project_psd(M, nz, floor);
+    }
     for (j = 0; j < HM_NX; j++)
         for (i = 0; i < HM_NX; i++) qp->Q[n][i + j * HM_NX] = M[i + j * nz];
     if (n < HM_N) {
