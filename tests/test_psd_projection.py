@@ -40,7 +40,8 @@ def project(exe: Path, kind: str, mats: list[np.ndarray], floor: float) -> list[
     proc = subprocess.run([str(exe)], input="\n".join(lines) + "\n", capture_output=True, text=True,
                           timeout=60, check=True)
     rows = proc.stdout.split("\n")[: len(mats)]
-    return [np.array([float(v) for v in r.split()]).reshape(m.shape, order="F") for r, m in zip(rows, mats, strict=True)]
+    return [np.array([float(v) for v in r.split()]).reshape(m.shape, order="F")
+            for r, m in zip(rows, mats, strict=True)]
 
 
 def reference(m: np.ndarray, floor: float) -> np.ndarray:
@@ -72,8 +73,9 @@ def test_jacobi_projection_matches_eigh_on_dense_indefinite_matrices(harness: Pa
 def test_closed_form_pair_matches_eigh_including_diagonal_and_repeated_eigenvalues(harness: Path) -> None:
     rng = np.random.default_rng(11)
     mats = [random_symmetric(rng, 2, s) for s in (1e-4, 1.0, 1e4) for _ in range(30)]
-    mats += [np.diag([-1.0, 2.0]), np.diag([2.0, -1.0]), np.diag([-3.0, -3.0]), np.array([[1.0, 1e-12], [1e-12, 1.0]]),
-             np.array([[0.0, 1.0], [1.0, 0.0]]), np.array([[-2.0, 0.5], [0.5, -2.0]]), np.array([[1e-9, 1.0], [1.0, 1e9]])]
+    mats += [np.diag([-1.0, 2.0]), np.diag([2.0, -1.0]), np.diag([-3.0, -3.0]),
+             np.array([[1.0, 1e-12], [1e-12, 1.0]]), np.array([[0.0, 1.0], [1.0, 0.0]]),
+             np.array([[-2.0, 0.5], [0.5, -2.0]]), np.array([[1e-9, 1.0], [1.0, 1e9]])]
     for floor in (1e-8, 0.3):
         for got, m in zip(project(harness, "pair", mats, floor), mats, strict=True):
             assert_projection(got, m, floor)
