@@ -1,0 +1,68 @@
+"""Where the contacts of the recorded crossings happen (docs/evaluation.md, issue 23).
+
+Runs the `mpc` planner (the built-in default spec's controller) over the recorded scenes' crossings
+and prints one row per contact event (a person's entry within the contact distance, as the
+evaluation counts them): the scene and crossing, the time, the fault (the evaluation's rule), the
+robot's speed, the person's bearing from the robot's heading, the person's speed, the person's
+distance one second earlier ("unseen" when they were not observed then) and the protective stops of
+that second. Then the counts: events by fault, person-fault events with the robot standing, with a stop
+in the last second, and with the person unseen a second before.
+
+    .venv/bin/python docs/contact_analysis.py [SCENE ...]     # default: the three scenes, ~3 minutes
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from humanmpc.eval.commands import choose_solver
+from humanmpc.eval.episode import run_episode
+from humanmpc.eval.metrics import MOVING_SPEED, person_distances, rising_edges, robot_at_fault
+from humanmpc.planners.registry import make_planner
+from humanmpc.sim.scenarios import RECORDED_CROSSINGS, make_scenario
+
+SCENES = ("biwi_eth", "biwi_hotel", "crowds_zara01")
+
+
+def main() -> None:
+    scenes = sys.argv[1:] or list(SCENES)
+    config = choose_solver(None, None)
+    rows = []
+    print("| scene | crossing | t [s] | fault | robot speed [m/s] | bearing [deg] | person's speed [m/s] "
+          "| distance 1 s before [m] | stops in that second |")
+    print("|---|---:|---:|---|---:|---:|---:|---:|---|")
+    for scene in scenes:
+        for seed in range(RECORDED_CROSSINGS):
+            log = run_episode(make_scenario(scene, seed), make_planner("mpc"), config)
+            touch = log.robot.radius + log.robot.human_radius  # the evaluation's contact distance
+            contact = person_distances(log.states[:, :2], log.humans, log.present) < touch
+            fault = robot_at_fault(log.states, log.humans) & contact
+            second = round(1.0 / log.dt)
+            for k in range(contact.shape[1]):
+                for e in rising_edges(contact[:, k]):
+                    x = log.states[e]
+                    rel = log.humans[e, k] - x[:2]
+                    bearing = (np.degrees(np.arctan2(rel[1], rel[0]) - x[2]) + 180.0) % 360.0 - 180.0
+                    speed = (np.linalg.norm(log.humans[e, k] - log.humans[e - 1, k]) / log.dt
+                             if e >= 1 and log.present[e - 1, k] else float("nan"))
+                    b = max(e - second, 0)
+                    before = (float(np.linalg.norm(log.humans[b, k] - log.states[b, :2]))
+                              if log.present[b, k] else None)
+                    stops = sorted({r for r in log.reasons[b:e] if r})
+                    rows.append((bool(fault[e, k]), float(x[3]), before, bool(stops)))
+                    print(f"| {scene} | {seed} | {log.times[e]:.1f} | {'robot' if fault[e, k] else 'person'} "
+                          f"| {x[3]:.2f} | {bearing:.0f} | {speed:.2f} "
+                          f"| {'unseen' if before is None else f'{before:.2f}'} | {', '.join(stops) or '-'} |",
+                          flush=True)
+    person = [r for r in rows if not r[0]]
+    standing = [r for r in person if abs(r[1]) <= MOVING_SPEED]
+    print(f"\ncontact events: {len(rows)} ({len(rows) - len(person)} robot's fault, {len(person)} the person's)")
+    print(f"person's fault: robot standing in {len(standing)}, of which {sum(r[3] for r in standing)} with a "
+          f"protective stop in the second before; person unseen a second before in "
+          f"{sum(r[2] is None for r in person)}")
+
+
+if __name__ == "__main__":
+    main()
