@@ -82,13 +82,15 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
     ocp_nlp_start_clock(s, t_start);
     ocp_nlp_clear_output(out);
     s->qp_solves = 0;
-    /* all QP solves of this step, the re-solves of screening and the braking retry's too: two QPs'
-     * worth (measured: at most 46 in 24,000 double steps at N_h = 30, 77 in float) */
-    s->qp_budget = 2 * s->params.qp_max_iter;
+    s->qp_budget = 0;
     out->sqp_iterations = 1;
     /* a whole step: its preparation, just now, checked the same input (s->prepared: it passed) */
     reason = ocp_nlp_check_before(s, in, !separate && s->prepared);
     if (reason == HM_STOP_NONE) {
+        /* all QP solves of this step, the re-solves of screening and the braking retry's too: two
+         * QPs' worth (measured: at most 46 in 24,000 double steps at N_h = 30, 77 in float); set once
+         * the parameters passed their check (a runtime qp_max_iter out of range overflowed it) */
+        s->qp_budget = 2 * s->params.qp_max_iter;
         if (!s->prepared) {
             ocp_nlp_rti_prepare(s, in);
         } else if (separate && ocp_nlp_params_changed(s)) {

@@ -100,6 +100,17 @@ def test_libfuzzer_over_step_feedback_solve_reset_parameters_and_clock_finds_not
     (corpus / "solve").write_bytes(bytes([5, 12, 1, 0, 0] + [1] * 120))
     (corpus / "clock").write_bytes(bytes([9, 1, 0, 2, 1] + [1] * 120))
     (corpus / "param").write_bytes(bytes([7, 8, 0, 1, 0, 0, 0, 0, 2, 1] + [1] * 120))
+    # found by this target (2026-11-24): a runtime qp_max_iter of 1.6e9 overflowed the step's QP budget
+    # before the parameters' check; kept as a seed, so that it runs first in every run
+    (corpus / "qp_max_iter_overflow").write_bytes(bytes.fromhex(
+        "050c010000010101010101010101010101010101010101010101010101010101010101fffefefefefefefc0101010101"
+        "010101010101010101010101010101010101010101010101010101010101010101010101011146464646464646464646"
+        "464646464646464646464646464646464646464646464646464646464646464646464646464646464646464646464646"
+        "46464646460101010101010101010101010101010101010101010101010101010101100000000101010101017f7f7f7f"
+        "7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f888080807f7f7f7f7f000000000000000000"
+        "00000000000000000000000000000000000000000000000000007f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f"
+        "7f7f7f7f7f0000000000000000000000000000007f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f"
+        "7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f7f0101"))
     proc = subprocess.run([str(exe), "-max_total_time=25", "-seed=1", "-rss_limit_mb=2048",
                            "-print_final_stats=1", str(corpus)],
                           capture_output=True, text=True, timeout=300, check=False, cwd=tmp_path)
