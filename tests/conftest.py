@@ -14,6 +14,21 @@ from humanmpc.codegen.build import build
 from humanmpc.codegen.generate import generate
 from humanmpc.codegen.spec import Spec, resolve_spec
 from humanmpc.planners.interface import Observation, PlanResult
+from humanmpc.sim.recorded import PEDESTRIANS_ENV, pedestrian_data_dir
+
+
+def _have_pedestrian_data() -> bool:
+    try:
+        pedestrian_data_dir()
+    except FileNotFoundError:
+        return False
+    return True
+
+
+# The recorded scenes (the files in ../shared/data/pedestrians, as CI has them): tests that replay them
+# are skipped, with the variable to set, where the checkout has no such sibling folder.
+HAVE_DATA = _have_pedestrian_data()
+needs_data = pytest.mark.skipif(not HAVE_DATA, reason=f"no pedestrian data (set {PEDESTRIANS_ENV})")
 
 QUIET: Callable[[str], None] = lambda _msg: None  # noqa: E731
 REPO_ROOT = Path(__file__).resolve().parent.parent

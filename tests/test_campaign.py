@@ -39,6 +39,8 @@ from humanmpc.planners.registry import planner_factory
 from humanmpc.planners.solver_dir import cached_solver
 from humanmpc.sim.scenarios import make_scenario
 
+from .conftest import needs_data
+
 cloudpickle.register_pickle_by_value(sys.modules[__name__])  # this module's functions run on Dask workers
 
 SEEDS = (0, 1, 2, 3)
@@ -101,6 +103,7 @@ def reference(default_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Re
     return Reference({r["key"]: r for r in store.read_rows()}, store)
 
 
+@needs_data
 def test_the_grid_has_every_cell_once_with_recorded_scenes_in_their_own_crowd(default_dir: Path) -> None:
     c = campaign(default_dir, scenarios=("crowdnav_circle_5", "biwi_hotel"), seeds=(0, 1), traces="first",
                  grid=parse_grid(["q=10,50", "reaction_time=0.3,0.5"]))

@@ -14,7 +14,7 @@ from humanmpc.sim.orca import OrcaCrowd, OrcaParams, obstacle_polygons
 from humanmpc.sim.scenarios import CROWDNAV_SCENARIOS, SIMULATED_SCENARIOS, make_scenario
 from humanmpc.sim.world import Circle, Polygon, World
 
-from .conftest import Recorder
+from .conftest import Recorder, needs_data
 
 RADIUS = OrcaParams().radius
 
@@ -111,6 +111,7 @@ def test_the_robot_far_away_disturbs_nobody_and_in_the_way_it_does(model: str) -
     assert (away.people_speed_change, away.people_heading_change) == (0.0, 0.0)
 
 
+@needs_data
 def test_recorded_people_ignore_the_crowd_model() -> None:
     scenario = make_scenario("biwi_hotel", 0)
     assert scenario.recorded and not isinstance(scenario.start_crowd(model="orca"), ReactiveCrowd)

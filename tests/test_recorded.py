@@ -32,7 +32,7 @@ from humanmpc.sim.scenarios import (
     plan_crossings,
 )
 from humanmpc.sim.world import World
-from tests.conftest import Recorder
+from tests.conftest import Recorder, needs_data
 
 # 25 frames per second, an annotation every 10 frames (0.4 s). Pedestrian 1 walks along x at 1 m/s and is
 # not seen at frame 130 (a gap: two tracks); pedestrian 2 stands at (5, 5) from frame 110 to 130; pedestrian 3
@@ -183,14 +183,6 @@ def test_an_episode_among_recorded_people_logs_who_is_present_and_shows_only_the
     assert m.min_human_distance == pytest.approx(3.0) and m.collisions == 0
 
 
-# The recorded scenes (the files in ../shared/data/pedestrians, as CI has them).
-
-try:
-    pedestrian_data_dir()
-    HAVE_DATA = True
-except FileNotFoundError:
-    HAVE_DATA = False
-needs_data = pytest.mark.skipif(not HAVE_DATA, reason=f"no pedestrian data (set {PEDESTRIANS_ENV})")
 
 
 @needs_data
