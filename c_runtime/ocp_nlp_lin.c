@@ -130,28 +130,41 @@ static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
         for (i = 0; i < n; i++)
             for (j = i + 1; j < n; j++) {
                 const hm_real aij = A[i + j * n];
-                hm_real theta, t, c, sn, tau;
+                const hm_real small = HM_R(100.0) * hm_fabs(aij);
+                hm_real h, t, g, sn, tau;
                 if (aij == HM_R(0.0)) continue;
-                theta = (A[j + j * n] - A[i + i * n]) / (HM_R(2.0) * aij);
-                t = (theta >= HM_R(0.0) ? HM_R(1.0) : HM_R(-1.0)) / (hm_fabs(theta) + hm_sqrt(theta * theta + HM_R(1.0)));
-                c = HM_R(1.0) / hm_sqrt(t * t + HM_R(1.0));
-                sn = t * c;
-                tau = sn / (HM_R(1.0) + c);
+                /* below the last bit of both diagonal entries: a rotation would not change them */
+                if (hm_fabs(A[i + i * n]) + small == hm_fabs(A[i + i * n]) &&
+                    hm_fabs(A[j + j * n]) + small == hm_fabs(A[j + j * n])) {
+                    A[i + j * n] = A[j + i * n] = HM_R(0.0);
+                    continue;
+                }
+                /* t = sgn(theta) / (|theta| + sqrt(theta^2 + 1)), theta = h / (2 aij), h = ajj - aii, the
+                 * smaller root of t^2 + 2 theta t - 1 = 0, with |2 aij| multiplied through: one division
+                 * less in the chain */
+                h = A[j + j * n] - A[i + i * n];
+                t = ((h >= HM_R(0.0)) == (aij >= HM_R(0.0)) ? HM_R(2.0) : HM_R(-2.0)) * hm_fabs(aij) /
+                    (hm_fabs(h) + hm_sqrt(h * h + HM_R(4.0) * aij * aij));
+                /* c = 1 / g, s = t / g and tau = s / (1 + c) = t / (g + 1): two divisions side by side
+                 * rather than three in a chain */
+                g = hm_sqrt(t * t + HM_R(1.0));
+                sn = t / g;
+                tau = t / (g + HM_R(1.0));
                 A[i + i * n] -= t * aij;
                 A[j + j * n] += t * aij;
                 A[i + j * n] = A[j + i * n] = HM_R(0.0);
                 for (k = 0; k < n; k++) {
-                    hm_real g, h;
+                    hm_real p, q;
                     if (k != i && k != j) {
-                        g = A[k + i * n];
-                        h = A[k + j * n];
-                        A[k + i * n] = A[i + k * n] = g - sn * (h + g * tau);
-                        A[k + j * n] = A[j + k * n] = h + sn * (g - h * tau);
+                        p = A[k + i * n];
+                        q = A[k + j * n];
+                        A[k + i * n] = A[i + k * n] = p - sn * (q + p * tau);
+                        A[k + j * n] = A[j + k * n] = q + sn * (p - q * tau);
                     }
-                    g = V[k + i * n];
-                    h = V[k + j * n];
-                    V[k + i * n] = g - sn * (h + g * tau);
-                    V[k + j * n] = h + sn * (g - h * tau);
+                    p = V[k + i * n];
+                    q = V[k + j * n];
+                    V[k + i * n] = p - sn * (q + p * tau);
+                    V[k + j * n] = q + sn * (p - q * tau);
                 }
             }
     }
