@@ -96,6 +96,8 @@ HM_FUNC void ocp_qp_ipm_write_sol_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_w
     for (i = 0; i < HM_NX; i++) sol->x[0][i] = qp->x0[i];
     for (n = 0; n <= HM_N; n++) {
         const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
+        /* the stage's clipped multiplier steps, written as write_stage writes an iterate's (slacks 0) */
+        hm_real zb[HM_QP_NUX][2], zr[HM_NG], zs[HM_NG], zh[HM_NG], none[HM_NG];
         if (n < HM_N) {
             for (i = 0; i < HM_NU; i++) sol->u[n][i] = HM_R(0.0);
             for (i = 0; i < HM_NX; i++) sol->pi[n][i] = -sc * sn->dy[i];
@@ -103,43 +105,17 @@ HM_FUNC void ocp_qp_ipm_write_sol_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_w
         if (n > 0) {
             for (i = 0; i < HM_NX; i++) sol->x[n][i] = HM_R(0.0);
         }
-        for (i = 0; i < HM_NG; i++) {
-            sol->s[n][i] = HM_R(0.0);
-            sol->lam_lg[n][i] = HM_R(0.0);
-            sol->lam_ls[n][i] = HM_R(0.0);
-        }
-        for (i = 0; i < HM_NX; i++) {
-            sol->lam_lbx[n][i] = HM_R(0.0);
-            sol->lam_ubx[n][i] = HM_R(0.0);
-        }
-        if (n < HM_N) {
-            for (i = 0; i < HM_NU; i++) {
-                sol->lam_lbu[n][i] = HM_R(0.0);
-                sol->lam_ubu[n][i] = HM_R(0.0);
-            }
-        }
         for (k = 0; k < bd->nbp; k++) {
-            const int c = bd->bc[k];
-            hm_real lo, up;
-            if (c < HM_NU ? n == HM_N : n == 0) continue;
-            lo = sc * bd->sg[k][0][n] * bd->sg[k][0][n] * OCP_QP_IPM_MAX(bd->dz[k][0][n], HM_R(0.0));
-            up = sc * bd->sg[k][1][n] * bd->sg[k][1][n] * OCP_QP_IPM_MAX(bd->dz[k][1][n], HM_R(0.0));
-            if (c < HM_NU) {
-                sol->lam_lbu[n][c] = lo;
-                sol->lam_ubu[n][c] = up;
-            } else {
-                sol->lam_lbx[n][c - HM_NU] = lo;
-                sol->lam_ubx[n][c - HM_NU] = up;
-            }
+            zb[k][0] = OCP_QP_IPM_MAX(bd->dz[k][0][n], HM_R(0.0));
+            zb[k][1] = OCP_QP_IPM_MAX(bd->dz[k][1][n], HM_R(0.0));
         }
         for (j = 0; j < sn->ns; j++) {
-            const int row = sn->soff + j;
-            const int i_row = sr->srow[row];
-            sol->s[n][i_row] = HM_R(0.0);
-            sol->lam_lg[n][i_row] = sc * OCP_QP_IPM_MAX(sr->sdz[row], HM_R(0.0));
-            sol->lam_ls[n][i_row] = sc * OCP_QP_IPM_MAX(sr->sdzs[row], HM_R(0.0));
+            zr[j] = OCP_QP_IPM_MAX(sr->sdz[sn->soff + j], HM_R(0.0));
+            zs[j] = OCP_QP_IPM_MAX(sr->sdzs[sn->soff + j], HM_R(0.0));
+            none[j] = HM_R(0.0);
         }
-        for (j = 0; j < sn->nh; j++) sol->lam_lg[n][sn->hrow[j]] = sc * OCP_QP_IPM_MAX(sn->hdz[j], HM_R(0.0));
+        for (j = 0; j < sn->nh; j++) zh[j] = OCP_QP_IPM_MAX(sn->hdz[j], HM_R(0.0));
+        ocp_qp_ipm_write_stage(sn, bd, sr, n, sol, (const hm_real (*)[2])zb, none, zr, zs, zh, sc, HM_R(1.0));
     }
 }
 
