@@ -134,32 +134,46 @@ class CrowdSpec:
         return CrowdSpec(pos, vel, wps, speeds, loops, tuple(tuple(int(i) for i in g) for g in groups))
 
 
-@dataclass
-class Crowd:
-    """The running simulation of a :class:`CrowdSpec` in a :class:`World`."""
+
+class Route:
+    """Every person's waypoints and the one each walks to now: how both crowd models (social force
+    here, ORCA in :mod:`humanmpc.sim.orca`) follow a :class:`CrowdSpec`'s routes."""
+
+    def __init__(self, spec: CrowdSpec) -> None:
+        k = spec.size
+        self._loop = spec.loop
+        self._count = np.array([len(w) for w in spec.waypoints], dtype=np.int64)
+        self._table = np.zeros((k, int(self._count.max()) if k else 1, 2))
+        for i, w in enumerate(spec.waypoints):
+            self._table[i, : len(w)] = w
+        self._index = np.zeros(k, dtype=np.int64)
+
+    @property
+    def goals(self) -> FloatArray:
+        """The waypoint each person walks to now, (k, 2)."""
+        return self._table[np.arange(self._index.size), self._index].copy()
+
+    @property
+    def final(self) -> NDArray[np.bool_]:
+        """(k,): walking to a last waypoint that does not loop."""
+        return ~(self._index + 1 < self._count) & ~self._loop
+
+    def advance(self, positions: FloatArray, radius: float) -> None:
+        """Everyone within ``radius`` of their waypoint moves on to the next (cycling when they loop)."""
+        reached = np.linalg.norm(self.goals - positions, axis=1) < radius
+        move_on = reached & ((self._index + 1 < self._count) | self._loop)
+        self._index = np.where(move_on, (self._index + 1) % self._count, self._index)
+
+
+class SimulatedCrowd:
+    """What the simulated crowd models share: a fixed set of people (ids ``0..k-1``) following their
+    :class:`Route`, with positions, velocities and the last step's undisturbed velocities."""
 
     spec: CrowdSpec
-    world: World = field(default_factory=World)
-    params: SocialForceParams = field(default_factory=SocialForceParams)
-    waypoint_radius: float = 0.5
-    time: float = field(init=False, default=0.0)
-
-    def __post_init__(self) -> None:
-        k = self.spec.size
-        self._pos = self.spec.positions.copy()
-        self._vel = self.spec.velocities.copy()
-        n_wp = np.array([len(w) for w in self.spec.waypoints], dtype=np.int64)
-        self._n_wp = n_wp
-        self._wp = np.zeros((k, int(n_wp.max()) if k else 1, 2))
-        for i, w in enumerate(self.spec.waypoints):
-            self._wp[i, : len(w)] = w
-        self._wp_idx = np.zeros(k, dtype=np.int64)
-        self._group_id = np.full(k, -1, dtype=np.int64)
-        for g_index, members in enumerate(self.spec.groups):
-            self._group_id[list(members)] = g_index
-        self._obstacle_samples = self.world.boundary_samples(self.params.obstacle_resolution)
-        self._max_speed = self.params.max_speed_factor * self.spec.desired_speeds
-        self._undisturbed: FloatArray | None = None
+    _route: Route
+    _pos: FloatArray
+    _vel: FloatArray
+    _undisturbed: FloatArray | None
 
     @property
     def size(self) -> int:
@@ -167,7 +181,7 @@ class Crowd:
 
     @property
     def ids(self) -> NDArray[np.int64]:
-        """Everyone, always: ``0..k-1`` (the simulated crowd's people never leave)."""
+        """Everyone, always: ``0..k-1`` (a simulated crowd's people never leave)."""
         return np.arange(self.size, dtype=np.int64)
 
     @property
@@ -180,15 +194,37 @@ class Crowd:
 
     @property
     def goals(self) -> FloatArray:
-        """The waypoint each human currently walks to, (k, 2)."""
-        return self._wp[np.arange(self.size), self._wp_idx].copy()
+        """The waypoint each person walks to now, (k, 2)."""
+        return self._route.goals
 
-    def _advance_waypoints(self) -> None:
-        goals = self.goals
-        reached = np.linalg.norm(goals - self._pos, axis=1) < self.waypoint_radius
-        has_next = self._wp_idx + 1 < self._n_wp
-        move_on = reached & (has_next | self.spec.loop)
-        self._wp_idx = np.where(move_on, (self._wp_idx + 1) % self._n_wp, self._wp_idx)
+    @property
+    def undisturbed_velocities(self) -> FloatArray | None:
+        """The velocities (k, 2) the last step would have given the people without the robot, from the same
+        state; None before a step with a robot the people see."""
+        return None if self._undisturbed is None else self._undisturbed.copy()
+
+
+@dataclass
+class Crowd(SimulatedCrowd):
+    """The running simulation of a :class:`CrowdSpec` in a :class:`World`."""
+
+    spec: CrowdSpec
+    world: World = field(default_factory=World)
+    params: SocialForceParams = field(default_factory=SocialForceParams)
+    waypoint_radius: float = 0.5
+    time: float = field(init=False, default=0.0)
+
+    def __post_init__(self) -> None:
+        k = self.spec.size
+        self._pos = self.spec.positions.copy()
+        self._vel = self.spec.velocities.copy()
+        self._route = Route(self.spec)
+        self._group_id = np.full(k, -1, dtype=np.int64)
+        for g_index, members in enumerate(self.spec.groups):
+            self._group_id[list(members)] = g_index
+        self._obstacle_samples = self.world.boundary_samples(self.params.obstacle_resolution)
+        self._max_speed = self.params.max_speed_factor * self.spec.desired_speeds
+        self._undisturbed: FloatArray | None = None
 
     def forces(self, robot_position: ArrayLike | None = None, robot_velocity: ArrayLike | None = None) -> FloatArray:
         """Total social force on every human, (k, 2)."""
@@ -226,19 +262,12 @@ class Crowd:
                 total += group
         return f, f0
 
-    @property
-    def undisturbed_velocities(self) -> FloatArray | None:
-        """The velocities (k, 2) the last step would have given the people without the robot, from the same
-        state (the same forces less the robot's repulsion); None before a step with a robot."""
-        return None if self._undisturbed is None else self._undisturbed.copy()
-
     def _velocities(self, force: FloatArray) -> FloatArray:
         """The step's velocities from ``force``: capped, zero for people who arrived at a final waypoint."""
         vel = self._vel + self.params.dt * force
         direction, speed = normalize(vel)
         vel = direction * np.minimum(speed, self._max_speed)[:, None]
-        final = ~(self._wp_idx + 1 < self._n_wp) & ~self.spec.loop
-        arrived = final & (np.linalg.norm(self.goals - self._pos, axis=1) < self.params.arrival_radius)
+        arrived = self._route.final & (np.linalg.norm(self.goals - self._pos, axis=1) < self.params.arrival_radius)
         vel[arrived] = 0.0
         return vel
 
@@ -247,7 +276,7 @@ class Crowd:
         if self.size == 0:
             self.time += self.params.dt
             return
-        self._advance_waypoints()
+        self._route.advance(self._pos, self.waypoint_radius)
         force, force0 = self._forces(robot_position, robot_velocity, without_robot=True)
         if not np.all(np.isfinite(force)):
             raise FloatingPointError("social force model produced a non-finite force; check the crowd state")

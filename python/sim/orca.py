@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .crowd import CrowdSpec
+from .crowd import CrowdSpec, Route, SimulatedCrowd
 from .world import World
 
 FloatArray = NDArray[np.float64]
@@ -96,7 +96,7 @@ def obstacle_polygons(world: World, circle_sides: int = 16) -> list[list[tuple[f
     return out
 
 
-class OrcaCrowd:
+class OrcaCrowd(SimulatedCrowd):
     """The people of a :class:`~humanmpc.sim.crowd.CrowdSpec` moved by ORCA in a :class:`World`.
 
     Implements :class:`~humanmpc.sim.crowd.HumanCrowd` (ids ``0..k-1``, everyone always present)."""
@@ -106,12 +106,7 @@ class OrcaCrowd:
         self.world = world or World()
         self.params = params or OrcaParams()
         self.time = 0.0
-        k = spec.size
-        self._n_wp = np.array([len(w) for w in spec.waypoints], dtype=np.int64)
-        self._wp = np.zeros((k, int(self._n_wp.max()) if k else 1, 2))
-        for i, w in enumerate(spec.waypoints):
-            self._wp[i, : len(w)] = w
-        self._wp_idx = np.zeros(k, dtype=np.int64)
+        self._route = Route(spec)
         self._sim = self._simulator(with_robot=self.params.robot_visible)
         self._ghost = self._simulator(with_robot=False) if self.params.robot_visible else None
         self._pos = spec.positions.astype(float).copy()
@@ -136,47 +131,13 @@ class OrcaCrowd:
             sim.process_obstacles()
         return sim
 
-    @property
-    def size(self) -> int:
-        return self.spec.size
-
-    @property
-    def ids(self) -> NDArray[np.int64]:
-        """Everyone, always: ``0..k-1``."""
-        return np.arange(self.size, dtype=np.int64)
-
-    @property
-    def positions(self) -> FloatArray:
-        return self._pos.copy()
-
-    @property
-    def velocities(self) -> FloatArray:
-        return self._vel.copy()
-
-    @property
-    def goals(self) -> FloatArray:
-        """The waypoint each person walks to now, (k, 2)."""
-        return self._wp[np.arange(self.size), self._wp_idx].copy()
-
-    @property
-    def undisturbed_velocities(self) -> FloatArray | None:
-        """The velocities (k, 2) the last step would have given the people without the robot, from the same
-        state; None before a step with a visible robot."""
-        return None if self._undisturbed is None else self._undisturbed.copy()
-
     def preferred_velocities(self) -> FloatArray:
         """Towards the current waypoint at the desired speed, slowing onto a final one (module docstring)."""
         to_goal = self.goals - self._pos
         dist = np.linalg.norm(to_goal, axis=1)
-        final = ~(self._wp_idx + 1 < self._n_wp) & ~self.spec.loop
-        speed = np.where(final, np.minimum(self.spec.desired_speeds, dist / self.params.slow_down_time),
+        speed = np.where(self._route.final, np.minimum(self.spec.desired_speeds, dist / self.params.slow_down_time),
                          self.spec.desired_speeds)
         return np.where(dist[:, None] > 1e-9, to_goal / np.maximum(dist, 1e-9)[:, None] * speed[:, None], 0.0)
-
-    def _advance_waypoints(self) -> None:
-        reached = np.linalg.norm(self.goals - self._pos, axis=1) < self.params.waypoint_radius
-        move_on = reached & ((self._wp_idx + 1 < self._n_wp) | self.spec.loop)
-        self._wp_idx = np.where(move_on, (self._wp_idx + 1) % self._n_wp, self._wp_idx)
 
     @staticmethod
     def _load(sim: Any, pos: FloatArray, vel: FloatArray, pref: FloatArray) -> None:
@@ -200,7 +161,7 @@ class OrcaCrowd:
         self.time += self.params.dt
         if k == 0:
             return
-        self._advance_waypoints()
+        self._route.advance(self._pos, self.params.waypoint_radius)
         pref = self.preferred_velocities()
         self._load(self._sim, self._pos, self._vel, pref)
         robot_here = robot_position is not None and self.params.robot_visible
