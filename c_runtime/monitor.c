@@ -106,14 +106,24 @@ HM_FUNC hm_real monitor_separation_bound(const hm_input *in, const hm_params *p,
 {
     const int k = n < HM_N ? n : HM_N - 1;
     const hm_real cos_t = hm_cos(x[2]), sin_t = hm_sin(x[2]);
+    const hm_real a_brake = -p->a_bounds[0], t_r = p->reaction_time;
+    /* monitor_separation_speed's reach, d_h + v_cap t_r + v_cap^2 / 2a + speed_h (t_r + v_cap / a), its
+     * terms summed in the same order: its two tests made here, once per person with the divisions by a
+     * once per call, and the call only for the few people near enough to bound v */
+    const hm_real reach0 = p->d_h + v_cap * t_r + v_cap * v_cap / (HM_R(2.0) * a_brake);
+    const hm_real reach_per_speed = t_r + v_cap / a_brake;
     hm_real bound = HM_INF;
     int j;
     for (j = 0; j < ocp_nlp_clamp_humans(in); j++) {
-        const hm_real vh[2] = {(in->humans_pred[k + 1][j][0] - in->humans_pred[k][j][0]) / HM_R(HM_DT),
-                               (in->humans_pred[k + 1][j][1] - in->humans_pred[k][j][1]) / HM_R(HM_DT)};
         const hm_real *h = n == 0 ? in->humans_now[j] : in->humans_pred[n][j];
-        bound = hm_fmin(bound, monitor_separation_speed(x, cos_t, sin_t, h, vh, p->d_h, p->reaction_time,
-                                                        -p->a_bounds[0], v_cap));
+        const hm_real dx = h[0] - x[0], dy = h[1] - x[1];
+        hm_real vh[2], reach;
+        if (!(cos_t * dx + sin_t * dy > HM_R(0.0))) continue;   /* behind: bounds nothing */
+        vh[0] = (in->humans_pred[k + 1][j][0] - in->humans_pred[k][j][0]) / HM_R(HM_DT);
+        vh[1] = (in->humans_pred[k + 1][j][1] - in->humans_pred[k][j][1]) / HM_R(HM_DT);
+        reach = reach0 + hm_sqrt(vh[0] * vh[0] + vh[1] * vh[1]) * reach_per_speed;
+        if (dx * dx + dy * dy >= reach * reach) continue;   /* too far to bound v_cap */
+        bound = hm_fmin(bound, monitor_separation_speed(x, cos_t, sin_t, h, vh, p->d_h, t_r, a_brake, v_cap));
     }
     return bound;
 }

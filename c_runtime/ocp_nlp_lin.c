@@ -108,14 +108,16 @@ HM_FUNC hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2)
 }
 
 /* Symmetric n x n M (column-major, n <= 6) replaced by its projection onto {eigenvalues >= floor}:
- * cyclic Jacobi rotations on the upper triangle (each rotation zeroes its pair and moves the other
+ * Jacobi sweeps over the upper triangle in round-robin order (each rotation zeroes its pair and moves the other
  * rows' two entries; Golub and Van Loan 8.5), then V max(Lambda, floor) V'. When every eigenvalue is
  * at least floor the projection is M itself, which is kept as it was: rebuilding it from V and
  * Lambda would only add rounding. */
 static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
 {
     hm_real A[36], V[36], off, total = HM_R(0.0);
-    int i, j, k, sweep, clipped = 0;
+    const int np = n + (n & 1);   /* places in the round robin: one a bye when n is odd */
+    int pos[6];
+    int i, j, k, m, round, sweep, clipped = 0;
     for (i = 0; i < n * n; i++) {
         A[i] = M[i];
         V[i] = HM_R(0.0);
@@ -127,11 +129,23 @@ static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
         for (j = 1; j < n; j++)
             for (i = 0; i < j; i++) off += A[i + j * n] * A[i + j * n];
         if (off <= HM_EPS * HM_EPS * total) break;
-        for (i = 0; i < n; i++)
-            for (j = i + 1; j < n; j++) {
-                const hm_real aij = A[i + j * n];
-                const hm_real small = HM_R(100.0) * hm_fabs(aij);
-                hm_real h, t, g, sn, tau;
+        /* A sweep in rounds of pairs that share no index (the round robin's: (0, 3) (1, 2), then (0, 2)
+         * (1, 3), then (0, 1) (2, 3) for n = 4). A rotation moves only rows and columns of its own pair,
+         * so every angle of a round comes from entries no other rotation of the round moves: the
+         * round's angles are computed first, their chains of square roots and divisions side by side,
+         * then its rotations applied. */
+        for (i = 0; i < np; i++) pos[i] = i;
+        for (round = 0; round < np - 1; round++) {
+            int ri[3], rj[3], nrot = 0;
+            hm_real rt[3], rsn[3], rtau[3], raij[3];
+            for (m = 0; m < np / 2; m++) {
+                const int a = pos[m], b = pos[np - 1 - m];
+                hm_real aij, small, h, t, g;
+                i = a < b ? a : b;
+                j = a < b ? b : a;
+                if (j >= n) continue;   /* the bye */
+                aij = A[i + j * n];
+                small = HM_R(100.0) * hm_fabs(aij);
                 if (aij == HM_R(0.0)) continue;
                 /* below the last bit of both diagonal entries: a rotation would not change them */
                 if (hm_fabs(A[i + i * n]) + small == hm_fabs(A[i + i * n]) &&
@@ -148,8 +162,18 @@ static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
                 /* c = 1 / g, s = t / g and tau = s / (1 + c) = t / (g + 1): two divisions side by side
                  * rather than three in a chain */
                 g = hm_sqrt(t * t + HM_R(1.0));
-                sn = t / g;
-                tau = t / (g + HM_R(1.0));
+                ri[nrot] = i;
+                rj[nrot] = j;
+                rt[nrot] = t;
+                rsn[nrot] = t / g;
+                rtau[nrot] = t / (g + HM_R(1.0));
+                raij[nrot] = aij;
+                nrot++;
+            }
+            for (m = 0; m < nrot; m++) {
+                const hm_real t = rt[m], sn = rsn[m], tau = rtau[m], aij = raij[m];
+                i = ri[m];
+                j = rj[m];
                 A[i + i * n] -= t * aij;
                 A[j + j * n] += t * aij;
                 A[i + j * n] = A[j + i * n] = HM_R(0.0);
@@ -167,6 +191,11 @@ static void ocp_nlp_project_psd(hm_real *M, int n, hm_real floor)
                     V[k + j * n] = q + sn * (p - q * tau);
                 }
             }
+            /* the circle method: the first place stays, the others move round by one */
+            k = pos[np - 1];
+            for (m = np - 1; m > 1; m--) pos[m] = pos[m - 1];
+            pos[1] = k;
+        }
     }
     {
         hm_real lam[6];
