@@ -90,18 +90,19 @@ static void ocp_nlp_screen_rows(hm_solver *s)
 static int ocp_nlp_admit_violated_rows(hm_solver *s, const hm_input *in, hm_real tol)
 {
     hm_ocp_qp *qp = &s->qp;
+    const int nh = ocp_nlp_clamp_humans(in);
     int n, j, added = 0;
     for (n = 1; n <= HM_N; n++) {
         const hm_real dp0 = s->mult.x[n][0], dp1 = s->mult.x[n][1];
-        const hm_real step2 = dp0 * dp0 + dp1 * dp1;
+        const hm_real step = hm_sqrt(dp0 * dp0 + dp1 * dp1);   /* once per node, not per row */
         for (j = 0; j < qp->ng[n]; j++) {
             hm_real lg;
             if (s->screened[n][j] && s->screened_lg[n][j] == -HM_INF) {
-                const int human = j < ocp_nlp_clamp_humans(in);
+                const int human = j < nh;
                 const hm_real *c = human ? in->humans_now[j] : in->obstacle;
                 const hm_real d_min = human ? s->params.d_h : s->params.d_s;
                 const hm_real dx = s->x[n][0] - c[0], dy = s->x[n][1] - c[1];
-                const hm_real reach = hm_sqrt(step2) + d_min;
+                const hm_real reach = step + d_min;
                 if (dx * dx + dy * dy > reach * reach) continue;   /* the step cannot reach it */
                 ocp_nlp_evaluate_row(s, in, n, j);
             }
