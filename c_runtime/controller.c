@@ -11,7 +11,9 @@
  *   cruising speed; the speed it tracks is at most goal_taper times the distance left.
  * - the approach: once the horizon reaches the goal, a speed to track over all of it makes the plan
  *   loop around the goal to spend its length; the approach drops that weight, weighs the position at
- *   every node and asks for the goal at rest.
+ *   every node and asks for the goal at rest. It also ends the collision potential at the robot's
+ *   earliest arrival (plus arrival_margin): predictions of people crossing the goal after the robot
+ *   has stopped there held it short of the goal.
  * - the loop recovery: a real-time iteration improves the last plan by one step, so it stays in the
  *   local solution it is in; when that is a loop (its end nearer its start than loop_ratio times its
  *   length), a few SQP iterations from a cold start find the direct one.
@@ -101,13 +103,15 @@ HM_FUNC void controller_init(hm_controller *c, const hm_params *params)
 }
 
 /* The solver's parameters for this period: the caller's, with the speed limit and, within the
- * horizon's reach of the goal, the approach weights. Sets the goal's speed (in->goal[3]). */
+ * horizon's reach of the goal, the approach weights and the collision potential's end. Sets the goal's
+ * speed (in->goal[3]). */
 static void controller_solver_params(hm_controller *c, const hm_controller_goal *g)
 {
     const hm_params *p = &c->params;
     hm_params *sp = &c->solver.params;
     const hm_real horizon = HM_R(HM_DT) * (hm_real)HM_N;
     const hm_real cap = hm_fmin(p->v_bounds[1], p->speed_limit);
+    hm_real v_arrive, arrival;
     *sp = *p;
     if (cap > p->v_bounds[0]) sp->v_bounds[1] = cap;
     c->in.goal[3] = hm_fmin(p->v_ref, p->goal_taper * g->left);
@@ -116,6 +120,18 @@ static void controller_solver_params(hm_controller *c, const hm_controller_goal 
         sp->w_goal[0] = sp->w_goal[1] = p->approach_position;
         sp->w_goal_terminal[3] = p->approach_stop;
         c->in.goal[3] = HM_R(0.0);
+        /* The plan's nodes after the robot has arrived describe a future the controller never drives:
+         * within goal_tolerance it brakes and reports the goal reached. People predicted to cross the
+         * goal after that pushed the whole plan away from it (corridor: the robot waited 0.34 m short of
+         * a goal that nobody was near, then a recovery left the corridor), so the potential acts only
+         * on the nodes up to the earliest arrival from rest (at v_ref or the speed cap, whichever is
+         * lower, reached at the upper acceleration bound), plus arrival_margin. Earlier nodes, the
+         * distance rows (people's current positions) and the speed-and-separation bound (predictions
+         * over the whole horizon) are unchanged. */
+        v_arrive = hm_fmin(p->v_ref, sp->v_bounds[1]);
+        arrival = hm_fmax(g->left - p->goal_tolerance, HM_R(0.0)) / v_arrive +
+                  v_arrive / (HM_R(2.0) * p->a_bounds[1]) + p->arrival_margin;
+        sp->collision_horizon = hm_fmin(p->collision_horizon, arrival);
     }
 }
 

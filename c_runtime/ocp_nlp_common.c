@@ -77,6 +77,13 @@ HM_FUNC hm_real ocp_nlp_collision_reach2(const hm_params *p)
     return p->kappa > HM_R(0.0) && reach < HM_R(1e6) ? reach * reach : HM_INF;
 }
 
+/* Node n's time against the collision potential's horizon, with half a period's slack so that a
+ * horizon of k periods keeps node k whatever the rounding of k * dt. */
+HM_FUNC int ocp_nlp_collision_node(const hm_params *p, int n)
+{
+    return HM_R(HM_DT) * ((hm_real)n - HM_R(0.5)) <= p->collision_horizon;
+}
+
 /* 1 when the human at h is within the collision potential's reach (squared, above) of the node at x. */
 HM_FUNC int ocp_nlp_collision_near(const hm_real *x, const hm_real *h, hm_real reach2)
 {

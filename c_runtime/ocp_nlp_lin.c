@@ -345,7 +345,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
 
         /* Collision cost of each present human within its reach at its predicted position at this
          * node: exact gradient, Gauss-Newton Hessian on the (px, py) block. */
-        for (j = 0; j < nh; j++) {
+        for (j = 0; ocp_nlp_collision_node(p, n) && j < nh; j++) {
             hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP], hess_exact[HM_NP * HM_NP];
             const hm_real *hess = hess_gn;
             if (!ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;

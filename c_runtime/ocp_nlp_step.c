@@ -64,7 +64,7 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
             hm_model_cost_terminal(x, in->goal, p->w_goal_terminal, &l, gx, hx);
         }
         merit += l;
-        for (j = 0; j < nh; j++) {
+        for (j = 0; ocp_nlp_collision_node(p, n) && j < nh; j++) {
             hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP];
             if (!ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;   /* as the linearisation */
             hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);

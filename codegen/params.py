@@ -199,6 +199,11 @@ PARAMS: tuple[Param, ...] = (
           valid=_DIST, problem=True),
     Param("kappa", "collision_cost.kappa", "real", 5.0, "steepness of the potential", unit="1/m",
           valid=Range(0.0, 1e3, lo_open=True), problem=True),
+    # Not in the Ipopt reference (like speed and separation): its OCP has the potential at every node, the
+    # default here; the controller shortens it during the approach only (controller.arrival_margin).
+    Param("collision_horizon", "collision_cost.horizon", "real", 1e4,
+          "time ahead over which the collision potential acts on people's predictions: nodes later than this "
+          "carry none (default: every node)", unit="s", valid=Range(0.0, 1e4)),
     Param("d_h", "humans.d_h", "real", 0.5, "hard minimum distance to a human's current position", unit="m",
           valid=_DIST, problem=True),
     Param("human_slack_l1", "humans.slack_l1", "real", 1e4,
@@ -273,6 +278,11 @@ PARAMS: tuple[Param, ...] = (
           "stage weight on px, py during the approach", valid=_WEIGHT, controller=True),
     Param("approach_stop", "controller.approach_stop", "real", 40.0,
           "terminal weight on v (to 0) during the approach", valid=_WEIGHT, controller=True),
+    Param("arrival_margin", "controller.arrival_margin", "real", 0.1,
+          "during the approach the collision potential ends (collision_horizon) at the robot's earliest "
+          "arrival within goal_tolerance, from rest at v_ref and the upper acceleration bound, plus this "
+          "margin: predictions of people crossing the goal after the robot has stopped there do not hold it "
+          "off (large: no end)", unit="s", valid=Range(0.0, 1e4), controller=True),
     Param("loop_ratio", "controller.loop_ratio", "real", 0.5,
           "a plan whose end is nearer its start than loop_ratio times its length is a loop (0: never)",
           valid=Range(0.0, 1.0, hi_open=True), controller=True, paper=0.0),

@@ -212,6 +212,7 @@ class CollisionCost:
     q: float = param("collision_cost.q")
     d_th: float = param("collision_cost.d_th")
     kappa: float = param("collision_cost.kappa")
+    horizon: float = param("collision_cost.horizon")
 
 
 @dataclass(frozen=True)
@@ -268,6 +269,7 @@ class Controller:
     approach: bool = param("controller.approach")
     approach_position: float = param("controller.approach_position")
     approach_stop: float = param("controller.approach_stop")
+    arrival_margin: float = param("controller.arrival_margin")
     loop_ratio: float = param("controller.loop_ratio")
     loop_min_length: float = param("controller.loop_min_length")
     recovery_iterations: int = param("controller.recovery_iterations")

@@ -221,6 +221,31 @@ def test_a_crossing_pair_is_let_through_or_passed_without_contact(ctl: Controlle
     assert run.min_distance() >= D_H
 
 
+def test_the_robot_reaches_a_goal_that_peoples_predicted_paths_cross(ctl: Controller) -> None:
+    """The goal 1.5 m ahead of the robot at rest; two people 5 m to either side walk across it at 1.2 m/s,
+    so their predictions reach the goal after about 4 s, when the robot, there after under 3 s, would
+    have stopped. The collision potential ends at the robot's earliest arrival (arrival_margin): it
+    arrives first, and never nearer anyone than d_th. Without that end (a margin beyond the horizon),
+    the predictions push the plan off the goal and the robot waits for them to pass."""
+    people = walking((1.5, -5.0, 0.0, 1.2), (1.5, 5.0, 0.0, -1.2))
+    run = drive(ctl, (0.0, 0.0, 0.0), (1.5, 0.0, 0.0), people=people, seconds=15.0)
+    assert run.results[-1].goal_reached
+    assert len(run.states) * DT < 3.5
+    assert run.min_distance() >= D_TH
+    ctl.reset()
+    ctl.set_params(arrival_margin=1e4)
+    waited = drive(ctl, (0.0, 0.0, 0.0), (1.5, 0.0, 0.0), people=people, seconds=15.0)
+    assert len(waited.states) * DT > 5.0
+
+
+def test_a_person_crossing_the_goal_before_the_robot_can_arrive_is_let_through(ctl: Controller) -> None:
+    """The same goal, one person 1.8 m to its side walking across it at 1.2 m/s: at the goal in 1.5 s,
+    before the robot can be (the potential still acts on those nodes). The robot lets them pass."""
+    run = drive(ctl, (0.0, 0.0, 0.0), (1.5, 0.0, 0.0), people=walking((1.5, -1.8, 0.0, 1.2)), seconds=15.0)
+    assert run.results[-1].goal_reached
+    assert run.min_distance() >= D_TH
+
+
 U_SHAPE = World((Polygon.rectangle((3.0, 0.0), 0.3, 4.0), Polygon.rectangle((1.6, 2.0), 3.0, 0.3),
                  Polygon.rectangle((1.6, -2.0), 3.0, 0.3)), (-4.0, 8.0, -5.0, 5.0))
 
