@@ -311,7 +311,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
         hm_real *x = s->x[n];
         hm_real *Q = qp->Q[n];
         hm_real *q = qp->q[n];
-        hm_real l;
+        hm_real l, far_h, far_o;
 
         if (n < HM_N) {
             if (s->dyn_fresh) {
@@ -380,6 +380,8 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
         if (p->separation && n >= 2)
             s->v_separation[n] = monitor_separation_bound(in, p, s->x[n - 1], n - 1, p->v_bounds[1]);
         qp->ng[n] = ng;
+        far_h = ocp_nlp_screen_far_reach(s, n, p->d_h);
+        far_o = ocp_nlp_screen_far_reach(s, n, p->d_s);
         for (j = 0; j < ng; j++) {
             const int human = j < nh;
             const hm_real *c = human ? in->humans_now[j] : in->obstacle;
@@ -393,7 +395,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
             /* beyond the screening radius by plain distance already: screened whatever its exact
              * margin, and not evaluated unless the QP's step could reach it (ocp_nlp_screen.c); with
              * the exact Hessian only without a multiplier, whose curvature it would carry */
-            if ((!exact || s->mult.lam_lg[n][j] == HM_R(0.0)) && ocp_nlp_screen_far(s, n, x, c, *d_min)) {
+            if ((!exact || s->mult.lam_lg[n][j] == HM_R(0.0)) && ocp_nlp_screen_far(x, c, human ? far_h : far_o)) {
                 qp->D[n][j][0] = qp->D[n][j][1] = HM_R(0.0);
                 qp->lg[n][j] = -HM_INF;
                 continue;

@@ -38,18 +38,24 @@ HM_FUNC void ocp_nlp_screen_reach(hm_solver *s)
     for (n = 0; n <= HM_N; n++) s->screen_radius[n] = HM_R(0.5) + vmax * HM_R(HM_DT) * (hm_real)n;
 }
 
-/* 1 when screening is on and the row of the point c (minimum distance d_min) at node n, linearised at
- * x, is beyond the stage's radius by plain distance already: |x - c| - d_min >= radius. The smooth
- * distance of the model is at least the plain one, so its margin is too: the row would be screened
- * (ocp_nlp_screen_rows). Such a row is not evaluated by the linearisation (lg = -HM_INF, D = 0; with
- * 100 people most of the 5,100 rows of a step): ocp_nlp_admit_violated_rows evaluates it only if the
- * QP's step moves its node far enough to reach it. */
-HM_FUNC int ocp_nlp_screen_far(const hm_solver *s, int n, const hm_real *x, const hm_real *c, hm_real d_min)
+/* The plain distance beyond which a row of node n with minimum distance d_min is screened whatever
+ * its exact margin: the stage's radius plus d_min, the smooth distance of the model being at least
+ * the plain one (ocp_nlp_screen_rows). HM_INF when screening is off or has no radii yet, so that no
+ * row is far. Taken once per node and kind of row, then tested per row by ocp_nlp_screen_far. */
+HM_FUNC hm_real ocp_nlp_screen_far_reach(const hm_solver *s, int n, hm_real d_min)
 {
     const hm_real reach = s->screen_radius[n] + d_min;
+    return s->params.row_screening && s->screen_radius[0] < HM_INF && reach > HM_R(0.0) ? reach : HM_INF;
+}
+
+/* 1 when the row of the point c at the node x is beyond reach (ocp_nlp_screen_far_reach) by plain
+ * distance: |x - c| >= reach. Such a row is not evaluated by the linearisation (lg = -HM_INF, D = 0;
+ * with 100 people most of the 5,100 rows of a step): ocp_nlp_admit_violated_rows evaluates it only if
+ * the QP's step moves its node far enough to reach it. */
+HM_FUNC int ocp_nlp_screen_far(const hm_real *x, const hm_real *c, hm_real reach)
+{
     const hm_real dx = x[0] - c[0], dy = x[1] - c[1];
-    return s->params.row_screening && s->screen_radius[0] < HM_INF && reach > HM_R(0.0)
-           && dx * dx + dy * dy >= reach * reach;
+    return reach < HM_INF && dx * dx + dy * dy >= reach * reach;
 }
 
 /* The row j of node n evaluated at the linearisation point (a row ocp_nlp_screen_far left out), into

@@ -15,8 +15,10 @@ HM_FUNC void ocp_nlp_screen_reach(hm_solver *s);
  * the last solve kept, a stage on. Adds the iterations to *qp_iter; returns the QP status. */
 HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, const hm_input *in, hm_real tol, int residuals, int shifted, int *qp_iter);
 
-/* 1 when screening is on and the row of the point c (minimum distance d_min) at node n, linearised at x,
- * is beyond the stage's screening radius by plain distance: the linearisation leaves it unevaluated. */
-HM_FUNC int ocp_nlp_screen_far(const hm_solver *s, int n, const hm_real *x, const hm_real *c, hm_real d_min);
+/* The plain distance beyond which a row of node n with minimum distance d_min is screened whatever its
+ * exact margin (HM_INF: screening off, no row is far), and the test of a row of the point c at the
+ * node x against it: far rows are left unevaluated by the linearisation. */
+HM_FUNC hm_real ocp_nlp_screen_far_reach(const hm_solver *s, int n, hm_real d_min);
+HM_FUNC int ocp_nlp_screen_far(const hm_real *x, const hm_real *c, hm_real reach);
 
 #endif /* OCP_NLP_SCREEN_H */
