@@ -74,23 +74,37 @@ HM_FUNC hm_real monitor_distance_now(const hm_input *in)
     return best;
 }
 
-HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_real sin_t, const hm_real *h,
-                                         const hm_real *vh, hm_real d_h, hm_real t_r, hm_real a_brake,
-                                         hm_real v_cap)
+/* The stopping reach, d_h + v_cap t_r + v_cap^2 / 2a + speed_h (t_r + v_cap / a): the farthest a person
+ * closing at speed_h can be and still bound a speed up to v_cap. Its terms that do not depend on the
+ * person (*reach0, and *per_speed, the reach per m/s of theirs) are taken once for many people. */
+static void monitor_separation_reach(hm_real d_h, hm_real t_r, hm_real a_brake, hm_real v_cap, hm_real *reach0,
+                                     hm_real *per_speed)
 {
-    const hm_real dx = h[0] - p[0], dy = h[1] - p[1];
-    const hm_real d2 = dx * dx + dy * dy;
-    const hm_real ahead = cos_t * dx + sin_t * dy; /* d cos_phi */
-    hm_real speed_h, reach, d, cos_phi, c, alpha, beta, gamma;
-    if (!(ahead > HM_R(0.0))) return HM_INF;
-    /* Most people are far: no square root when even v_cap, with the person's whole speed towards the
-     * robot, keeps the separation. */
-    speed_h = hm_sqrt(vh[0] * vh[0] + vh[1] * vh[1]);
-    reach = d_h + v_cap * t_r + v_cap * v_cap / (HM_R(2.0) * a_brake) + speed_h * (t_r + v_cap / a_brake);
-    if (d2 >= reach * reach) return HM_INF;
-    d = hm_sqrt(d2);
-    cos_phi = ahead / d;
-    c = -(vh[0] * dx + vh[1] * dy) / d;
+    *reach0 = d_h + v_cap * t_r + v_cap * v_cap / (HM_R(2.0) * a_brake);
+    *per_speed = t_r + v_cap / a_brake;
+}
+
+/* 1 when the person at (dx, dy) from the robot is ahead of its heading: only they bound its speed. */
+static int monitor_separation_ahead(hm_real cos_t, hm_real sin_t, hm_real dx, hm_real dy)
+{
+    return cos_t * dx + sin_t * dy > HM_R(0.0);
+}
+
+/* 1 when the person at (dx, dy), velocity vh, is beyond the stopping reach: even v_cap, with their
+ * whole speed towards the robot, keeps the separation. Most people are: no root for them. */
+static int monitor_separation_far(hm_real dx, hm_real dy, const hm_real *vh, hm_real reach0, hm_real per_speed)
+{
+    const hm_real reach = reach0 + hm_sqrt(vh[0] * vh[0] + vh[1] * vh[1]) * per_speed;
+    return dx * dx + dy * dy >= reach * reach;
+}
+
+/* The largest speed for a person ahead and within reach, at (dx, dy) from the robot (see monitor.h). */
+static hm_real monitor_separation_root(hm_real cos_t, hm_real sin_t, hm_real dx, hm_real dy, const hm_real *vh,
+                                       hm_real d_h, hm_real t_r, hm_real a_brake)
+{
+    const hm_real d = hm_sqrt(dx * dx + dy * dy);
+    const hm_real cos_phi = (cos_t * dx + sin_t * dy) / d;
+    hm_real c = -(vh[0] * dx + vh[1] * dy) / d, alpha, beta, gamma;
     if (c < HM_R(0.0)) c = HM_R(0.0);
     /* alpha v^2 + beta v + gamma <= 0, gamma < 0 for a bound above 0: its positive root, written
      * without the cancellation of -beta + sqrt(...) */
@@ -101,29 +115,38 @@ HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_rea
     return HM_R(-2.0) * gamma / (beta + hm_sqrt(beta * beta - HM_R(4.0) * alpha * gamma));
 }
 
+HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_real sin_t, const hm_real *h,
+                                         const hm_real *vh, hm_real d_h, hm_real t_r, hm_real a_brake,
+                                         hm_real v_cap)
+{
+    const hm_real dx = h[0] - p[0], dy = h[1] - p[1];
+    hm_real reach0, per_speed;
+    if (!monitor_separation_ahead(cos_t, sin_t, dx, dy)) return HM_INF;
+    monitor_separation_reach(d_h, t_r, a_brake, v_cap, &reach0, &per_speed);
+    if (monitor_separation_far(dx, dy, vh, reach0, per_speed)) return HM_INF;
+    return monitor_separation_root(cos_t, sin_t, dx, dy, vh, d_h, t_r, a_brake);
+}
+
 HM_FUNC hm_real monitor_separation_bound(const hm_input *in, const hm_params *p, const hm_real *x, int n,
                                          hm_real v_cap)
 {
     const int k = n < HM_N ? n : HM_N - 1;
     const hm_real cos_t = hm_cos(x[2]), sin_t = hm_sin(x[2]);
     const hm_real a_brake = -p->a_bounds[0], t_r = p->reaction_time;
-    /* monitor_separation_speed's reach, d_h + v_cap t_r + v_cap^2 / 2a + speed_h (t_r + v_cap / a), its
-     * terms summed in the same order: its two tests made here, once per person with the divisions by a
-     * once per call, and the call only for the few people near enough to bound v */
-    const hm_real reach0 = p->d_h + v_cap * t_r + v_cap * v_cap / (HM_R(2.0) * a_brake);
-    const hm_real reach_per_speed = t_r + v_cap / a_brake;
-    hm_real bound = HM_INF;
+    hm_real bound = HM_INF, reach0, per_speed;
     int j;
+    /* monitor_separation_speed for each person, with the reach's divisions taken once per call and the
+     * velocity's two only for the people ahead */
+    monitor_separation_reach(p->d_h, t_r, a_brake, v_cap, &reach0, &per_speed);
     for (j = 0; j < ocp_nlp_clamp_humans(in); j++) {
         const hm_real *h = n == 0 ? in->humans_now[j] : in->humans_pred[n][j];
         const hm_real dx = h[0] - x[0], dy = h[1] - x[1];
-        hm_real vh[2], reach;
-        if (!(cos_t * dx + sin_t * dy > HM_R(0.0))) continue;   /* behind: bounds nothing */
+        hm_real vh[2];
+        if (!monitor_separation_ahead(cos_t, sin_t, dx, dy)) continue;
         vh[0] = (in->humans_pred[k + 1][j][0] - in->humans_pred[k][j][0]) / HM_R(HM_DT);
         vh[1] = (in->humans_pred[k + 1][j][1] - in->humans_pred[k][j][1]) / HM_R(HM_DT);
-        reach = reach0 + hm_sqrt(vh[0] * vh[0] + vh[1] * vh[1]) * reach_per_speed;
-        if (dx * dx + dy * dy >= reach * reach) continue;   /* too far to bound v_cap */
-        bound = hm_fmin(bound, monitor_separation_speed(x, cos_t, sin_t, h, vh, p->d_h, t_r, a_brake, v_cap));
+        if (monitor_separation_far(dx, dy, vh, reach0, per_speed)) continue;
+        bound = hm_fmin(bound, monitor_separation_root(cos_t, sin_t, dx, dy, vh, p->d_h, t_r, a_brake));
     }
     return bound;
 }
