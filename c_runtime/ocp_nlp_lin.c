@@ -312,6 +312,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
         hm_real *Q = qp->Q[n];
         hm_real *q = qp->q[n];
         hm_real l, far_h, far_o;
+        int nh_cost;
 
         if (n < HM_N) {
             if (s->dyn_fresh) {
@@ -345,7 +346,9 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
 
         /* Collision cost of each present human within its reach at its predicted position at this
          * node: exact gradient, Gauss-Newton Hessian on the (px, py) block. */
-        for (j = 0; ocp_nlp_collision_node(p, n) && j < nh; j++) {
+        /* the people whose potential this node carries: none beyond the potential's horizon */
+        nh_cost = ocp_nlp_collision_node(p, n) ? nh : 0;
+        for (j = 0; j < nh_cost; j++) {
             hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP], hess_exact[HM_NP * HM_NP];
             const hm_real *hess = hess_gn;
             if (!ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;

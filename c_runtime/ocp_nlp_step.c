@@ -55,6 +55,7 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
     for (n = 0; n <= HM_N; n++) {
         const hm_real *x = s->x[n];
         hm_real l, gx[HM_NX], hx[HM_NX * HM_NX];
+        int nh_cost;
         if (n < HM_N) {
             hm_real gu[HM_NU], hu[HM_NU * HM_NU], x_next[HM_NX], A[HM_NX * HM_NX], B[HM_NX * HM_NU];
             hm_model_dynamics(x, s->u[n], x_next, A, B);
@@ -64,7 +65,9 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
             hm_model_cost_terminal(x, in->goal, p->w_goal_terminal, &l, gx, hx);
         }
         merit += l;
-        for (j = 0; ocp_nlp_collision_node(p, n) && j < nh; j++) {
+        /* the people whose potential this node carries: none beyond the potential's horizon */
+        nh_cost = ocp_nlp_collision_node(p, n) ? nh : 0;
+        for (j = 0; j < nh_cost; j++) {
             hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP];
             if (!ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;   /* as the linearisation */
             hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
