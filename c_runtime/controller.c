@@ -276,6 +276,8 @@ static void controller_report(const hm_controller *c, hm_controller_output *out)
     out->qp_status = o->qp_status;
     out->qp_iterations = o->qp_iterations;
     out->sqp_iterations = o->sqp_iterations;
+    out->qp_rows = o->qp_rows;
+    out->qp_rows_capped = o->qp_rows_capped;
     out->min_human_distance = o->min_human_distance;
     for (n = 0; n <= HM_N; n++)
         for (i = 0; i < HM_NX; i++) out->plan[n][i] = o->x[n][i];

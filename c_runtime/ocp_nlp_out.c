@@ -161,6 +161,8 @@ HM_FUNC void ocp_nlp_clear_output(hm_output *out)
     out->qp_iterations = 0;
     out->sqp_iterations = 0;
     out->qp_solves = 0;
+    out->qp_rows = 0;
+    out->qp_rows_capped = 0;
     out->cost = HM_R(0.0);
     out->kkt_stat = HM_R(0.0);
     out->kkt_eq = HM_R(0.0);

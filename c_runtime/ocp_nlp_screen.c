@@ -72,11 +72,12 @@ static void ocp_nlp_evaluate_row(hm_solver *s, const hm_input *in, int n, int j)
 
 /* Rows with margin -lg = d - d_min not below the stage's radius leave the QP: their lg is kept in
  * screened_lg and made absent (-HM_INF), which the QP solvers skip like any absent bound. Nothing
- * else of the QP moves, so putting a row back is one store. */
-static void ocp_nlp_screen_rows(hm_solver *s)
+ * else of the QP moves, so putting a row back is one store. Returns the rows kept (rows of node 0,
+ * which the QP ignores, never have a present lg: ocp_nlp_lin.c). */
+static int ocp_nlp_screen_rows(hm_solver *s)
 {
     hm_ocp_qp *qp = &s->qp;
-    int n, j;
+    int n, j, kept = 0;
     for (n = 0; n <= HM_N; n++) {
         const hm_real radius = s->screen_radius[n];
         for (j = 0; j < qp->ng[n]; j++) {
@@ -85,8 +86,10 @@ static void ocp_nlp_screen_rows(hm_solver *s)
             s->screened[n][j] = (unsigned char)out;
             s->screened_lg[n][j] = lg;
             qp->lg[n][j] = out ? -HM_INF : lg;
+            kept += !out;
         }
     }
+    return kept;
 }
 
 /* Rows left out that the QP's step violates (by more than tol) join the QP; returns how many. A row
@@ -144,6 +147,86 @@ static void ocp_nlp_unscreen_rows(hm_solver *s, hm_ocp_qp_sol *sol)
     }
 }
 
+/* ------------------------------------------------------------------------------------------------
+ * Row capacity
+ *
+ * The QP solvers hold at most HM_QP_NRC soft rows (solver.qp_rows; by default sized so that the
+ * closed loops of the evaluation almost never need more, docs/benchmarks.md). A QP with more rows
+ * than that keeps the HM_QP_NRC of smallest margin: the linearised margin D' dp - lg at the QP's step
+ * dp of the row's node (at the linearisation point before the first solve, dp = 0: -lg, the distance
+ * beyond d_min); the others leave it as screened rows do and are checked after the solve like them.
+ * A row left out that the step violates comes back, and the rows of largest margin at that step
+ * leave instead, within the rounds of screening; what the last round leaves out violated is not
+ * in the step's QP, whose plan the monitor then checks as it checks every plan (C1, C2). Counted in
+ * the step's output (qp_rows_capped).
+ * ---------------------------------------------------------------------------------------------- */
+
+/* The linearised margin of present row j of node n at the step (dp0, dp1) of its node. */
+HM_KERNEL hm_real ocp_nlp_row_margin(const hm_ocp_qp *qp, int n, int j, hm_real dp0, hm_real dp1)
+{
+    return qp->D[n][j][0] * dp0 + qp->D[n][j][1] * dp1 - qp->lg[n][j];
+}
+
+/* Rows present in the QP with margin <= theta (at the step of each node if at_step, else at the
+ * linearisation point); all present rows with theta = HM_INF. */
+static int ocp_nlp_rows_within(const hm_solver *s, int at_step, hm_real theta)
+{
+    const hm_ocp_qp *qp = &s->qp;
+    int n, j, within = 0;
+    for (n = 1; n <= HM_N; n++) {
+        const hm_real dp0 = at_step ? s->mult.x[n][0] : HM_R(0.0), dp1 = at_step ? s->mult.x[n][1] : HM_R(0.0);
+        for (j = 0; j < qp->ng[n]; j++)
+            if (ocp_qp_bound_present(qp->lg[n][j])) within += ocp_nlp_row_margin(qp, n, j, dp0, dp1) <= theta;
+    }
+    return within;
+}
+
+/* Keeps the QP, with present rows in it, within its row capacity (above); returns the rows it left
+ * out. The threshold of the kept margins is found by bisection over counts (no sort, no memory: it
+ * runs only when the capacity binds); rows at the threshold are kept in order while there is room. */
+static int ocp_nlp_keep_capacity(hm_solver *s, int at_step, int present)
+{
+    hm_ocp_qp *qp = &s->qp;
+    hm_real lo = HM_INF, hi = -HM_INF;
+    int n, j, kept = 0, out = 0, it;
+    if (present > s->qp_rows_max) s->qp_rows_max = present;
+    if (present <= HM_QP_NRC) return 0;
+    for (n = 1; n <= HM_N; n++) {
+        const hm_real dp0 = at_step ? s->mult.x[n][0] : HM_R(0.0), dp1 = at_step ? s->mult.x[n][1] : HM_R(0.0);
+        for (j = 0; j < qp->ng[n]; j++) {
+            hm_real m;
+            if (!ocp_qp_bound_present(qp->lg[n][j])) continue;
+            m = ocp_nlp_row_margin(qp, n, j, dp0, dp1);
+            if (m < lo) lo = m;
+            if (m > hi) hi = m;
+        }
+    }
+    /* count(margin <= lo) <= capacity < count(margin <= hi), but for ties at lo */
+    for (it = 0; it < 64; it++) {
+        const hm_real mid = lo + (hi - lo) * HM_R(0.5);
+        if (!(mid > lo && mid < hi)) break;
+        if (ocp_nlp_rows_within(s, at_step, mid) <= HM_QP_NRC) lo = mid;
+        else hi = mid;
+    }
+    for (n = 1; n <= HM_N; n++) {
+        const hm_real dp0 = at_step ? s->mult.x[n][0] : HM_R(0.0), dp1 = at_step ? s->mult.x[n][1] : HM_R(0.0);
+        for (j = 0; j < qp->ng[n]; j++) {
+            const hm_real lg = qp->lg[n][j];
+            if (!ocp_qp_bound_present(lg)) continue;
+            if (ocp_nlp_row_margin(qp, n, j, dp0, dp1) <= lo && kept < HM_QP_NRC) {
+                kept++;
+                continue;
+            }
+            s->screened[n][j] = 1;
+            s->screened_lg[n][j] = lg;
+            qp->lg[n][j] = -HM_INF;
+            out++;
+        }
+    }
+    s->qp_rows_capped++;
+    return out;
+}
+
 /* Screening radii of the next QP from the displacements of this QP's step (see above). */
 static void ocp_nlp_size_screening(hm_solver *s)
 {
@@ -164,10 +247,14 @@ static void ocp_nlp_size_screening(hm_solver *s)
 HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, const hm_input *in, hm_real tol, int residuals, int shifted, int *qp_iter)
 {
     const int screen = s->params.row_screening && s->screen_radius[0] < HM_INF;
-    int status = HM_QP_MAX_ITER, round;
+    int status = HM_QP_MAX_ITER, round, left_out, present, k;
     s->ipm_arg.tol = tol;
     s->ipm_arg.residuals = residuals;
-    if (screen) ocp_nlp_screen_rows(s);
+    present = screen ? ocp_nlp_screen_rows(s) : ocp_nlp_rows_within(s, 0, HM_INF);
+    /* rows left out by the capacity are checked after the solve as screened rows are, screening or not */
+    k = ocp_nlp_keep_capacity(s, 0, present);
+    present -= k;
+    left_out = k > 0;
     for (round = 0;; round++) {
         s->ipm_arg.max_iter = s->params.qp_max_iter;
         if (s->qp_budget >= 0) {
@@ -184,19 +271,30 @@ HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, const hm_input *in, hm_real tol, int 
         *qp_iter += s->ipm_ws.out.iter;
         if (s->qp_budget >= 0) s->qp_budget -= s->ipm_ws.out.iter;
         s->qp_solves++;
-        if (!screen || !ocp_nlp_qp_usable(status)) break;
+        if (!(screen || left_out) || !ocp_nlp_qp_usable(status)) break;
         if (round == OCP_NLP_SCREEN_ROUNDS) {
-            /* pathological: rows keep turning up; the whole QP settles it (every row evaluated) */
+            /* pathological: rows keep turning up; the whole QP settles it (every row evaluated), as far
+             * as the capacity holds it: the rows of smallest margin at this step */
             int n, j;
             for (n = 1; n <= HM_N; n++)
                 for (j = 0; j < s->qp.ng[n]; j++)
                     if (s->screened[n][j] && s->screened_lg[n][j] == -HM_INF) ocp_nlp_evaluate_row(s, in, n, j);
             ocp_nlp_unscreen_rows(s, 0);
+            present = ocp_nlp_rows_within(s, 0, HM_INF);
+            k = ocp_nlp_keep_capacity(s, 1, present);
+            present -= k;
+            left_out = k > 0;
             continue;
         }
-        if (round > OCP_NLP_SCREEN_ROUNDS || ocp_nlp_admit_violated_rows(s, in, tol) == 0) break;
+        if (round > OCP_NLP_SCREEN_ROUNDS) break;
+        k = ocp_nlp_admit_violated_rows(s, in, tol);
+        if (k == 0) break;
+        present += k;
+        k = ocp_nlp_keep_capacity(s, 1, present);
+        present -= k;
+        if (k > 0) left_out = 1;
     }
-    if (screen) ocp_nlp_unscreen_rows(s, &s->mult);
+    if (screen || left_out) ocp_nlp_unscreen_rows(s, &s->mult);
     if (ocp_nlp_qp_usable(status)) ocp_nlp_size_screening(s);
     return status;
 }

@@ -30,6 +30,8 @@ typedef struct HM_NS(solver) {
      * n - 1 (ocp_nlp_lin.c); node 1's from the measured state, at feedback. */
     HM_REAL v_separation[HM_N + 1];
     int qp_solves;   /* QPs solved in the current step */
+    int qp_rows_max;     /* the most soft rows one of the step's QPs had, before the capacity (HM_QP_NRC) */
+    int qp_rows_capped;  /* QPs of the step that had more, and held the HM_QP_NRC of smallest margin */
     int qp_budget;   /* interior-point iterations left to the real-time iteration's QP solves in this step
                         (2 qp_max_iter at its start: its re-solves and braking retry share them, which bounds
                         the work of a step); < 0: each QP may take qp_max_iter (the full SQP) */

@@ -31,9 +31,9 @@ HM_FUNC hm_real ocp_qp_hsde_tau_pivot(const hm_ocp_qp *restrict qp, const hm_ocp
         ocp_qp_hsde_stage_hess_mul(qp, n, ws->cost_scale, d, Hd);
         for (i = 0; i < HM_QP_NUX; i++) acc += d[i] * Hd[i];
         for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            const hm_real ds = v1->s[n][kr] - tinv * v->s[n][kr];
-            acc += ws->soft_Zl[n][j] * ds * ds;
+            const int kr = ws->soft_of[ws->soff[n] + j];
+            const hm_real ds = v1->s[ws->roff[n] + kr] - tinv * v->s[ws->roff[n] + kr];
+            acc += ws->soft_Zl[ws->soff[n] + j] * ds * ds;
         }
     }
     for (j = 0; j < ws->m; j++) acc += v1->z[j] * v1->z[j] * ocp_qp_hsde_weight(ws->t[j], v->z[j], ws->w_max).winv;
@@ -48,8 +48,8 @@ HM_FUNC void ocp_qp_hsde_vec_axpy_except_z(const hm_ocp_qp_hsde_ws *restrict ws,
     for (n = 0; n <= HM_N; n++) {
         for (i = 0; i < HM_QP_NUX; i++) y->ux[n][i] += a * x->ux[n][i];
         for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            y->s[n][kr] += a * x->s[n][kr];
+            const int kr = ws->soft_of[ws->soff[n] + j];
+            y->s[ws->roff[n] + kr] += a * x->s[ws->roff[n] + kr];
         }
     }
     for (n = 0; n < HM_N; n++) {
@@ -74,8 +74,8 @@ HM_FUNC hm_real ocp_qp_hsde_direction(const hm_ocp_qp *restrict qp, hm_ocp_qp_hs
     for (n = 0; n <= HM_N; n++) {
         for (i = 0; i < HM_QP_NUX; i++) d->ux[n][i] = -keep * r->ux[n][i];
         for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            d->s[n][kr] = -keep * r->s[n][kr];
+            const int kr = ws->soft_of[ws->soff[n] + j];
+            d->s[ws->roff[n] + kr] = -keep * r->s[ws->roff[n] + kr];
         }
     }
     for (n = 0; n < HM_N; n++) {
@@ -127,8 +127,8 @@ HM_FUNC void ocp_qp_hsde_constant_rhs(const hm_ocp_qp_hsde_ws *restrict ws, hm_o
     for (n = 0; n <= HM_N; n++) {
         for (i = 0; i < HM_QP_NUX; i++) a->ux[n][i] = -ws->q_ux[n][i];
         for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            a->s[n][kr] = -ws->q_s[n][kr];
+            const int kr = ws->soft_of[ws->soff[n] + j];
+            a->s[ws->roff[n] + kr] = -ws->q_s[ws->roff[n] + kr];
         }
     }
     for (n = 0; n < HM_N; n++) {
@@ -169,11 +169,11 @@ HM_FUNC void ocp_qp_hsde_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_hsde_ws 
                 else sol->lam_lbx[n][c - HM_NU] = lam;
             }
         }
-        for (k = 0; k < nr; k++) sol->lam_lg[n][ws->row_idx[n][k]] = sc * v->z[base + k];
+        for (k = 0; k < nr; k++) sol->lam_lg[n][ws->row_idx[ws->roff[n] + k]] = sc * v->z[base + k];
         for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[n][j];
-            const int i_row = ws->row_idx[n][kr];
-            sol->s[n][i_row] = sp * v->s[n][kr];
+            const int kr = ws->soft_of[ws->soff[n] + j];
+            const int i_row = ws->row_idx[ws->roff[n] + kr];
+            sol->s[n][i_row] = sp * v->s[ws->roff[n] + kr];
             sol->lam_ls[n][i_row] = sc * v->z[base + nr + j];
         }
     }
@@ -231,7 +231,10 @@ HM_FUNC void ocp_qp_hsde_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
             ocp_qp_hsde_residuals(qp, ws, d, ws->dt, HM_R(1.0), 0, &sm);
             for (n = 0; n <= HM_N; n++) {
                 for (i = 0; i < HM_QP_NUX; i++) e->ux[n][i] = -r->ux[n][i];
-                for (j = 0; j < ws->ns[n]; j++) e->s[n][ws->soft_of[n][j]] = -r->s[n][ws->soft_of[n][j]];
+                for (j = 0; j < ws->ns[n]; j++) {
+                    const int kr = ws->roff[n] + ws->soft_of[ws->soff[n] + j];
+                    e->s[kr] = -r->s[kr];
+                }
             }
             for (n = 0; n < HM_N; n++) {
                 for (i = 0; i < HM_NX; i++) e->y[n][i] = -r->y[n][i];
@@ -240,7 +243,10 @@ HM_FUNC void ocp_qp_hsde_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
             ocp_qp_hsde_kkt_solve(qp, ws, e, e);
             for (n = 0; n <= HM_N; n++) {
                 for (i = 0; i < HM_QP_NUX; i++) d->ux[n][i] += e->ux[n][i];
-                for (j = 0; j < ws->ns[n]; j++) d->s[n][ws->soft_of[n][j]] += e->s[n][ws->soft_of[n][j]];
+                for (j = 0; j < ws->ns[n]; j++) {
+                    const int kr = ws->roff[n] + ws->soft_of[ws->soff[n] + j];
+                    d->s[kr] += e->s[kr];
+                }
             }
             for (n = 0; n < HM_N; n++) {
                 for (i = 0; i < HM_NX; i++) d->y[n][i] += e->y[n][i];

@@ -30,7 +30,11 @@
 /* Inequality rows of one stage at most (both sides of the components that may be bounded,
  * HM_QP_NBP of ocp_qp_kkt.h), and of the whole QP. */
 #define HM_QP_HSDE_NC_STAGE (2 * HM_QP_NBP + 2 * HM_NG)
-#define HM_QP_HSDE_NC_MAX ((HM_N + 1) * HM_QP_HSDE_NC_STAGE)
+/* General rows of the whole QP at most: the soft ones (HM_QP_NRC) and a stage's hard ones (HM_QP_NGH)
+ * in every stage, never more than every row; and the inequality rows in all (with the s >= 0 of the
+ * soft rows). */
+#define HM_QP_HSDE_NGR HM_QP_MIN_((HM_N + 1) * HM_NG, HM_QP_NRC + (HM_N + 1) * HM_QP_NGH)
+#define HM_QP_HSDE_NC_MAX ((HM_N + 1) * 2 * HM_QP_NBP + HM_QP_HSDE_NGR + HM_QP_NRC)
 
 /* Solve qp from scratch; returns an enum hm_qp_status (also in ws->out.status); ws->out.iter iterations. */
 HM_FUNC int ocp_qp_hsde_solve(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_qp_hsde_ws *ws,

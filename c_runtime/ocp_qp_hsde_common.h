@@ -1,11 +1,17 @@
 /*
  * ocp_qp_hsde_common.h: what the files of the fallback solver (ocp_qp_hsde*.c) share: max without
- * libm, the row weights of the Newton matrix. No state.
+ * libm, the row weights of the Newton matrix, the checks of the sizes its types write out. No state.
  */
 #ifndef OCP_QP_HSDE_COMMON_H
 #define OCP_QP_HSDE_COMMON_H
 
 #include "hm_common.h"
+#include "ocp_qp_hsde.h"
+
+/* ocp_qp_hsde_types.h writes the sizes out: its packed rows must be HM_QP_HSDE_NGR and HM_QP_HSDE_NC_MAX */
+typedef char ocp_qp_hsde_ngr_matches[sizeof(((hm_ocp_qp_hsde_ws *)0)->row_idx) == HM_QP_HSDE_NGR ? 1 : -1];
+typedef char ocp_qp_hsde_nc_matches[sizeof(((hm_ocp_qp_hsde_ws *)0)->t) == HM_QP_HSDE_NC_MAX * sizeof(hm_real) ? 1 : -1];
+typedef char ocp_qp_hsde_nrc_matches[sizeof(((hm_ocp_qp_hsde_ws *)0)->soft_of) == HM_QP_NRC ? 1 : -1];
 
 /* max without libm's fmax call (whose NaN rule is not needed here: NaN is caught on the sums) */
 #define OCP_QP_HSDE_MAX(a, b) ((a) > (b) ? (a) : (b))

@@ -24,14 +24,17 @@
 
 /* Packs the present inequality rows and computes the data of the embedding and its norms. Returns
  * HM_QP_INFEASIBLE if a lower bound exceeds its upper bound (*bad = stage * HM_QP_NUX + component),
- * HM_QP_NONFINITE if a stage bounds more components than the solver was sized for (HM_QP_NBP). */
+ * HM_QP_NONFINITE if a stage bounds more components, or the QP has more rows, than the solver was
+ * sized for (HM_QP_NBP; HM_QP_HSDE_NGR rows, HM_QP_NRC soft ones). */
 HM_FUNC int ocp_qp_hsde_setup(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws, int *bad)
 {
-    int n, i, k, m = 0;
+    int n, i, k, m = 0, roff = 0, soff = 0;
     hm_real norm_q = HM_R(0.0), norm_b = HM_R(0.0), hscale = HM_R(0.0);
     for (n = 0; n <= HM_N; n++) {
         int nb = 0, nr = 0, ns = 0, nbc = 0;
         ws->off[n] = m;
+        ws->roff[n] = roff;
+        ws->soff[n] = soff;
         for (i = 0; i < HM_QP_NUX; i++) {
             hm_real lb, ub;
             if (i < HM_NU) {
@@ -65,18 +68,22 @@ HM_FUNC int ocp_qp_hsde_setup(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws, int *b
         if (n > 0) {
             for (i = 0; i < qp->ng[n]; i++) {
                 if (!ocp_qp_bound_present(qp->lg[n][i])) continue;
-                ws->row_idx[n][nr] = (unsigned char)i;
-                ws->D[n][nr][0] = qp->D[n][i][0];
-                ws->D[n][nr][1] = qp->D[n][i][1];
+                /* more rows than the solver holds (HM_QP_HSDE_NGR, HM_QP_NRC; the NLP keeps within them) */
+                if (roff + nr == HM_QP_HSDE_NGR || (qp->soft[n][i] && soff + ns == HM_QP_NRC)) return HM_QP_NONFINITE;
+                ns += qp->soft[n][i] != 0;
+                ws->row_idx[ws->roff[n] + nr] = (unsigned char)i;
+                ws->D[ws->roff[n] + nr][0] = qp->D[n][i][0];
+                ws->D[ws->roff[n] + nr][1] = qp->D[n][i][1];
                 ws->b_ineq[m + nb + nr] = -qp->lg[n][i];
                 nr++;
             }
+            ns = 0;
             for (k = 0; k < nr; k++) {
-                const int i_row = ws->row_idx[n][k];
+                const int i_row = ws->row_idx[ws->roff[n] + k];
                 if (!qp->soft[n][i_row]) continue;
-                ws->soft_of[n][ns] = (unsigned char)k;
+                ws->soft_of[ws->soff[n] + ns] = (unsigned char)k;
                 ws->b_ineq[m + nb + nr + ns] = HM_R(0.0);
-                ws->q_s[n][k] = qp->zl[n][i_row];
+                ws->q_s[ws->roff[n] + k] = qp->zl[n][i_row];
                 norm_q = OCP_QP_HSDE_MAX(norm_q, hm_fabs(qp->zl[n][i_row]));
                 hscale = OCP_QP_HSDE_MAX(hscale, hm_fabs(qp->Zl[n][i_row]));
                 ns++;
@@ -87,8 +94,10 @@ HM_FUNC int ocp_qp_hsde_setup(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws, int *b
         ws->ns[n] = ns;
         /* the tau row is evaluated by every solve, also those before the first residuals */
         for (i = 0; i < HM_QP_NUX; i++) ws->c_ux[n][i] = HM_R(0.0);
-        for (k = 0; k < nr; k++) ws->c_s[n][k] = HM_R(0.0);
+        for (k = 0; k < nr; k++) ws->c_s[ws->roff[n] + k] = HM_R(0.0);
         m += nb + nr + ns;
+        roff += nr;
+        soff += ns;
 
         /* linear cost on (u, x); x_0 is data, its terms move into stage 0 */
         for (i = 0; i < HM_NU; i++) {
@@ -129,8 +138,8 @@ HM_FUNC int ocp_qp_hsde_setup(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws, int *b
         const hm_real c = HM_R(1.0) / (mag < HM_R(1e-4) ? HM_R(1e-4) : (mag > HM_R(1e4) ? HM_R(1e4) : mag));
         for (n = 0; n <= HM_N; n++) {
             for (i = 0; i < HM_QP_NUX; i++) ws->q_ux[n][i] *= c;
-            for (k = 0; k < ws->nr[n]; k++) ws->q_s[n][k] *= c;
-            for (k = 0; k < ws->ns[n]; k++) ws->soft_Zl[n][k] = c * qp->Zl[n][ws->row_idx[n][ws->soft_of[n][k]]];
+            for (k = 0; k < ws->nr[n]; k++) ws->q_s[ws->roff[n] + k] *= c;
+            for (k = 0; k < ws->ns[n]; k++) ws->soft_Zl[ws->soff[n] + k] = c * qp->Zl[n][ws->row_idx[ws->roff[n] + ws->soft_of[ws->soff[n] + k]]];
         }
         ws->cost_scale = c;
         ws->norm_q = norm_q * c;

@@ -19,6 +19,9 @@ typedef char ocp_qp_ipm_nbp_matches[sizeof(((hm_ocp_qp_ipm_bounds *)0)->bc) == H
 typedef char ocp_qp_ipm_nghp_matches[sizeof(((hm_ocp_qp_ipm_stage *)0)->hrow) == HM_QP_NGHP ? 1 : -1];
 typedef char ocp_qp_ipm_nbp_range[HM_QP_NBP >= 1 && HM_QP_NBP <= HM_QP_NUX ? 1 : -1];
 typedef char ocp_qp_ipm_ngh_range[HM_QP_NGH >= 0 && HM_QP_NGH <= HM_NG ? 1 : -1];
+/* and the soft rows a QP may hold: at least one, at most every row */
+typedef char ocp_qp_ipm_nrc_range[HM_QP_NRC >= 1 && HM_QP_NRC <= (HM_N + 1) * HM_NG ? 1 : -1];
+typedef char ocp_qp_ipm_nrc_matches[sizeof(((hm_ocp_qp_ipm_ws *)0)->warm.srow) == HM_QP_NRC ? 1 : -1];
 
 /* max/min without libm's calls (whose NaN rule is not needed here: NaN is caught on the sums) */
 #define OCP_QP_IPM_MAX(a, b) ((a) > (b) ? (a) : (b))

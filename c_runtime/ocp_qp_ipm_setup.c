@@ -64,12 +64,13 @@ HM_FUNC void ocp_qp_ipm_rows_absent(hm_ocp_qp_ipm_rows *sr, int r)
 
 /* Builds the stage blocks of qp and the starting point. Returns HM_QP_INFEASIBLE if a lower bound
  * exceeds its upper bound (*bad = stage * HM_QP_NUX + component), HM_QP_NONFINITE if the QP has more
- * bounded components or hard rows in a stage than the solver was sized for (HM_QP_NBP, HM_QP_NGH). */
+ * bounded components or hard rows in a stage, or soft rows in all, than the solver was sized for
+ * (HM_QP_NBP, HM_QP_NGH, HM_QP_NRC). */
 HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad)
 {
     hm_ocp_qp_ipm_bounds *bd = &ws->u.f.bd;
     hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
-    int n, i, j, k, l, m = 0, off = 0;
+    int n, i, j, k, l, m = 0, off = 0, nsoft = 0;
     int bounded[HM_QP_NUX];
     hm_real norm_q = HM_R(0.0), norm_b = HM_R(0.0), hscale = HM_R(0.0), c;
 
@@ -144,6 +145,9 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
                 norm_b = OCP_QP_IPM_MAX(norm_b, hm_fabs(lg));
                 if (qp->soft[n][i]) {
                     const int row = off + ns;
+                    /* more soft rows than the solver holds (HM_QP_NRC; the NLP keeps within it) */
+                    if (nsoft == HM_QP_NRC) return HM_QP_NONFINITE;
+                    nsoft++;
                     sr->srow[row] = (unsigned char)i;
                     sr->sd0[row] = qp->D[n][i][0];
                     sr->sd1[row] = qp->D[n][i][1];

@@ -45,6 +45,15 @@
 #define HM_TYPES_NGHP_ ((HM_NG + 1) / 2 * 2)
 #endif
 #define HM_TYPES_NNP_ ((HM_N + 8) / 8 * 8)
+#ifdef HM_NRC
+#define HM_TYPES_NRC_ (HM_NRC)
+#else
+#define HM_TYPES_NRC_ ((HM_N + 1) * HM_NG)
+#endif
+#define HM_TYPES_MIN_(a, b) ((a) < (b) ? (a) : (b))
+#define HM_TYPES_NR_                                                                                      \
+    ((HM_TYPES_MIN_((HM_N + 1) * ((HM_NG + 1) / 2 * 2), HM_TYPES_NRC_ + HM_TYPES_MIN_(HM_TYPES_NRC_, HM_N + 1)) \
+      + 7) / 8 * 8)
 
 
 /* One stage of the solver: its inequality families, its part of the iterate and of the direction,
@@ -128,10 +137,10 @@ typedef struct HM_NS(ocp_qp_ipm_bounds) {
  * list only holds present rows). sdr, sdsb (from pass C to pass E) are free in pass A, which keeps
  * its per-row terms there and in se until the stages have summed them (ocp_qp_ipm_pass_a.c). */
 /* one value per row of the list */
-typedef HM_REAL HM_NS(ocp_qp_ipm_row_vec)[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];
+typedef HM_REAL HM_NS(ocp_qp_ipm_row_vec)[HM_TYPES_NR_];
 typedef struct HM_NS(ocp_qp_ipm_rows) {
     int nr;                           /* rows in the list, padding rows of the stages included */
-    unsigned char srow[((HM_N + 1) * ((HM_NG + 1) / 2 * 2) + 7) / 8 * 8];   /* QP row within its stage */
+    unsigned char srow[HM_TYPES_NR_];   /* QP row within its stage */
     HM_NS(ocp_qp_ipm_row_vec) sd0, sd1, slg, szl, sZl, slive;
     HM_NS(ocp_qp_ipm_row_vec) ss, st;        /* slack s, row slack t */
     HM_NS(ocp_qp_ipm_row_vec) sz, szs;       /* multipliers of the row, of s >= 0 */
@@ -167,16 +176,21 @@ typedef struct HM_NS(ocp_qp_ipm_general) {
 
 /* An iterate kept by a solve for the next one's start (arg->warm_start, warm_mu): its slacks and
  * multipliers (unscaled) by stage and bound slot (whose components bc are kept too) or QP row, so
- * that the next QP may have other bounds and rows. */
+ * that the next QP may have other bounds and rows. The rows are kept as the solve held them: the soft
+ * rows of stage n at soff[n] .. soff[n] + ns[n] - 1 of a list without padding, its hard rows in its
+ * slots, each with its QP row (ascending within a stage, as the setup lists them). */
 typedef struct HM_NS(ocp_qp_ipm_warm) {
     int ready;                                   /* 1: the last solve kept one */
     int nbp;                                     /* bound slots of the kept iterate, and their components */
     unsigned char bc[HM_TYPES_NBP_];
     HM_REAL bt[HM_N + 1][HM_TYPES_NBP_][2];      /* bound sides (lower, upper): slack, 0 if absent */
     HM_REAL bz[HM_N + 1][HM_TYPES_NBP_][2];      /* and multiplier */
-    HM_REAL rt[HM_N + 1][HM_NG], rz[HM_N + 1][HM_NG];     /* rows: slack, multiplier */
-    HM_REAL rs[HM_N + 1][HM_NG], rzs[HM_N + 1][HM_NG];    /* soft rows: s, multiplier of s >= 0 */
-    unsigned char kind[HM_N + 1][HM_NG];         /* 0 absent, 1 soft, 2 hard */
+    int soff[HM_N + 1], ns[HM_N + 1], nh[HM_N + 1];
+    unsigned char srow[HM_TYPES_NRC_];           /* soft rows: QP row, */
+    HM_REAL st[HM_TYPES_NRC_], sz[HM_TYPES_NRC_];       /* row slack and multiplier, */
+    HM_REAL ss[HM_TYPES_NRC_], szs[HM_TYPES_NRC_];      /* s and the multiplier of s >= 0 */
+    unsigned char hrow[HM_N + 1][HM_TYPES_NGHP_];       /* hard rows: QP row, */
+    HM_REAL ht[HM_N + 1][HM_TYPES_NGHP_], hz[HM_N + 1][HM_TYPES_NGHP_];   /* slack and multiplier */
 } HM_NS(ocp_qp_ipm_warm);
 
 /* All memory of a solve. Only the first block is meant for the caller. */
@@ -208,3 +222,6 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
 #undef HM_TYPES_NBP_
 #undef HM_TYPES_NGHP_
 #undef HM_TYPES_NNP_
+#undef HM_TYPES_NRC_
+#undef HM_TYPES_MIN_
+#undef HM_TYPES_NR_

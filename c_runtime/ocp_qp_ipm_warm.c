@@ -32,7 +32,7 @@ HM_FUNC void ocp_qp_ipm_warm_keep(hm_ocp_qp_ipm_ws *ws)
     const hm_ocp_qp_ipm_rows *sr = &ws->u.f.sr;
     hm_ocp_qp_ipm_warm *w = &ws->warm;
     const hm_real cinv = HM_R(1.0) / ws->cost_scale;
-    int n, k, l, j;
+    int n, k, l, j, off = 0;
     w->nbp = bd->nbp;
     for (k = 0; k < bd->nbp; k++) w->bc[k] = bd->bc[k];
     for (n = 0; n <= HM_N; n++) {
@@ -44,20 +44,22 @@ HM_FUNC void ocp_qp_ipm_warm_keep(hm_ocp_qp_ipm_ws *ws)
                 w->bz[n][k][l] = present ? bd->z[k][l][n] * cinv : HM_R(0.0);
             }
         }
-        for (j = 0; j < HM_NG; j++) w->kind[n][j] = 0;
+        w->soff[n] = off;
+        w->ns[n] = sn->ns;
         for (j = 0; j < sn->ns; j++) {
-            const int row = sn->soff + j, i = sr->srow[row];
-            w->kind[n][i] = 1;
-            w->rt[n][i] = sr->st[row];
-            w->rz[n][i] = sr->sz[row] * cinv;
-            w->rs[n][i] = sr->ss[row];
-            w->rzs[n][i] = sr->szs[row] * cinv;
+            const int row = sn->soff + j;
+            w->srow[off + j] = sr->srow[row];
+            w->st[off + j] = sr->st[row];
+            w->sz[off + j] = sr->sz[row] * cinv;
+            w->ss[off + j] = sr->ss[row];
+            w->szs[off + j] = sr->szs[row] * cinv;
         }
+        off += sn->ns;
+        w->nh[n] = sn->nh;
         for (j = 0; j < sn->nh; j++) {
-            const int i = sn->hrow[j];
-            w->kind[n][i] = 2;
-            w->rt[n][i] = sn->ht[j];
-            w->rz[n][i] = sn->hz[j] * cinv;
+            w->hrow[n][j] = sn->hrow[j];
+            w->ht[n][j] = sn->ht[j];
+            w->hz[n][j] = sn->hz[j] * cinv;
         }
     }
     w->ready = 1;
@@ -96,19 +98,31 @@ HM_FUNC void ocp_qp_ipm_warm_apply(hm_ocp_qp_ipm_ws *ws, int shift)
                 bd->z[k][l][n] = ocp_qp_ipm_warm_floor(w->bz[m][kept[k]][l] * c);
             }
         }
-        for (j = 0; j < sn->ns; j++) {
-            const int row = sn->soff + j, i = sr->srow[row];
-            if (w->kind[m][i] != 1) continue;
-            sr->st[row] = ocp_qp_ipm_warm_floor(w->rt[m][i]);
-            sr->sz[row] = ocp_qp_ipm_warm_floor(w->rz[m][i] * c);
-            sr->ss[row] = ocp_qp_ipm_warm_floor(w->rs[m][i]);
-            sr->szs[row] = ocp_qp_ipm_warm_floor(w->rzs[m][i] * c);
+        /* the rows of the kept stage with the QP rows of this one: both lists ascend */
+        {
+            int a = w->soff[m];
+            const int end = a + w->ns[m];
+            for (j = 0; j < sn->ns; j++) {
+                const int row = sn->soff + j, i = sr->srow[row];
+                while (a < end && w->srow[a] < i) a++;
+                if (a == end) break;
+                if (w->srow[a] != i) continue;
+                sr->st[row] = ocp_qp_ipm_warm_floor(w->st[a]);
+                sr->sz[row] = ocp_qp_ipm_warm_floor(w->sz[a] * c);
+                sr->ss[row] = ocp_qp_ipm_warm_floor(w->ss[a]);
+                sr->szs[row] = ocp_qp_ipm_warm_floor(w->szs[a] * c);
+            }
         }
-        for (j = 0; j < sn->nh; j++) {
-            const int i = sn->hrow[j];
-            if (w->kind[m][i] != 2) continue;
-            sn->ht[j] = ocp_qp_ipm_warm_floor(w->rt[m][i]);
-            sn->hz[j] = ocp_qp_ipm_warm_floor(w->rz[m][i] * c);
+        {
+            int a = 0;
+            for (j = 0; j < sn->nh; j++) {
+                const int i = sn->hrow[j];
+                while (a < w->nh[m] && w->hrow[m][a] < i) a++;
+                if (a == w->nh[m]) break;
+                if (w->hrow[m][a] != i) continue;
+                sn->ht[j] = ocp_qp_ipm_warm_floor(w->ht[m][a]);
+                sn->hz[j] = ocp_qp_ipm_warm_floor(w->hz[m][a] * c);
+            }
         }
     }
 }

@@ -34,8 +34,17 @@
 #define HM_QP_NNP ((HM_N + 8) / 8 * 8)
 /* rows per stage rounded up to even: rows are processed in pairs */
 #define HM_QP_NGP ((HM_NG + 1) / 2 * 2)
-/* the soft rows of all stages, each stage padded to even, the list to a multiple of 8 */
-#define HM_QP_NR (((HM_N + 1) * HM_QP_NGP + 7) / 8 * 8)
+/* soft rows a QP may hold in all stages together: the solver's HM_NRC (a generated solver's
+ * solver.qp_rows), by default every row of every stage; a QP with more is refused by the setups */
+#ifdef HM_NRC
+#define HM_QP_NRC (HM_NRC)
+#else
+#define HM_QP_NRC ((HM_N + 1) * HM_NG)
+#endif
+#define HM_QP_MIN_(a, b) ((a) < (b) ? (a) : (b))
+/* the soft rows' list: the rows of all stages, each stage padded to even (a padding row for a stage
+ * with an odd count, so at most HM_N + 1 of them), the list to a multiple of 8 */
+#define HM_QP_NR ((HM_QP_MIN_((HM_N + 1) * HM_QP_NGP, HM_QP_NRC + HM_QP_MIN_(HM_QP_NRC, HM_N + 1)) + 7) / 8 * 8)
 /* components of (u, x) that may be bounded (bound-pair slots) and hard rows a stage may have: the
  * solver's HM_NBP and HM_NGH, by default all (ocp_qp_ipm_types.h); hard-row slots per stage, rounded
  * up to even and at least one pair */

@@ -92,6 +92,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
     print(f"  spec sha256  {m['spec_hash']}")
     print(f"  sizes        N={dims['N']} intervals of dt={dims['dt']:g} s (T={dims['T']:g} s), "
           f"N_h={dims['nh']} humans, {dims['ng']} distance rows/node, nx={dims['nx']}, nu={dims['nu']}")
+    if "qp_rows" in dims:
+        print(f"  QP rows      at most {dims['qp_rows']} distance rows in one QP (solver.qp_rows; of "
+              f"{(int(dims['N']) + 1) * int(dims['ng'])} in all)")
     print("  files")
     for p in sorted(d.rglob("*")):
         if p.is_file() and "build" not in p.relative_to(d).parts[:-1]:

@@ -60,6 +60,7 @@ def _populate(spec: Spec, out: Path) -> dict[str, object]:
             "N": context["N"],
             "nh": context["NH"],
             "ng": context["NG"],
+            "qp_rows": context["QP_ROWS"],
             "dt": spec.dt,
             "T": spec.horizon.T,
         },

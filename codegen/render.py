@@ -170,6 +170,7 @@ def template_context(spec: Spec, functions: list[EmittedFunction], real: str) ->
         "N": int(spec.horizon.N),
         "NH": int(spec.humans.max),
         "NG": int(spec.n_rows),
+        "QP_ROWS": int(spec.qp_row_capacity),
         "NH_ALLOC": max(1, int(spec.humans.max)),  # C has no zero-length arrays
         "NT": int(spec.controller.max_tracks),
         "NP": int(spec.controller.max_path_points),

@@ -236,8 +236,19 @@ class Bounds:
     omega: tuple[float, float] = param("bounds.omega")
 
 
+# Distance rows one QP holds at most when the spec leaves solver.qp_rows at 0 (fewer if the problem has
+# fewer): measured on the evaluation's closed loops, docs/benchmarks.md ("Row capacity").
+DEFAULT_QP_ROWS = 256
+
+
 @dataclass(frozen=True)
 class Solver:
+    qp_rows: int = integer(
+        0, "distance rows one QP holds at most (a fixed size: the QP solvers' memory and the work of an "
+        "iteration are sized by it); a QP with more holds those of smallest margin and checks the others at "
+        f"its solution. 0: {DEFAULT_QP_ROWS}, or every row ((N + 1) (N_h + 1)) if there are fewer; with "
+        "solver.row_screening off every row is in the QP, so give every row to solve whole QPs",
+        ge=0, le=10_000_000)
     regularization: float = param("solver.regularization")
     qp_max_iter: int = param("solver.qp_max_iter")
     qp_tol: float = param("solver.qp_tol")
@@ -317,6 +328,13 @@ class Spec:
     def n_rows(self) -> int:
         """General rows per stage: one per human and one for the closest obstacle."""
         return self.humans.max + 1
+
+    @property
+    def qp_row_capacity(self) -> int:
+        """Distance rows one QP holds at most: solver.qp_rows (0: DEFAULT_QP_ROWS), never more than the
+        (N + 1) (N_h + 1) rows the problem has."""
+        rows = (self.horizon.N + 1) * self.n_rows
+        return min(rows, self.solver.qp_rows or DEFAULT_QP_ROWS)
 
     def to_dict(self) -> dict[str, Any]:
         return _plain(dataclasses.asdict(self))

@@ -54,6 +54,8 @@ class StepResult:
     x, u                planned states (N+1, 4) and controls (N, 2)
     status, qp_status   see ``status_name``, ``qp_status_name``
     qp_iterations, sqp_iterations, qp_solves (QPs solved: row screening re-solves, the braking retry)
+    qp_rows, qp_rows_capped (the most distance rows one of the step's QPs had, and how many QPs had more
+                        than the solver's capacity ``solver.qp_rows``: they held those of smallest margin)
     cost, kkt_stat, kkt_eq, kkt_ineq, kkt_comp, min_human_distance (inf: no human)
     time_prepare_ms, time_feedback_ms, time_total_ms
     """
@@ -90,6 +92,8 @@ class StepResult:
     qp_iterations = _field("qp_iterations", int)
     sqp_iterations = _field("sqp_iterations", int)
     qp_solves = _field("qp_solves", int)
+    qp_rows = _field("qp_rows", int)
+    qp_rows_capped = _field("qp_rows_capped", int)
     cost = _field("cost", float)
     kkt_stat = _field("kkt_stat", float)
     kkt_eq = _field("kkt_eq", float)
@@ -199,6 +203,8 @@ class ControllerResult:
     qp_status = _field("qp_status", int)
     qp_iterations = _field("qp_iterations", int)
     sqp_iterations = _field("sqp_iterations", int)
+    qp_rows = _field("qp_rows", int)
+    qp_rows_capped = _field("qp_rows_capped", int)
     distance_to_goal = _field("distance_to_goal", float)
     time_without_progress = _field("time_without_progress", float)
     min_human_distance = _field("min_human_distance", float)

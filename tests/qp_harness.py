@@ -151,6 +151,8 @@ int qp_harness_check(void);
 void qp_harness_arg(int max_iter, double tol, double tol_infeas, int stop_after, int polish);
 void qp_harness_warm(int warm_start, double warm_mu);
 int qp_harness_solve(void);
+int qp_harness_solve_fallback(void);
+int qp_harness_rows(void);
 int qp_harness_info(int *iter, int *polls, int *flags, double *res6, double *scaled3, double *mtk3);
 void qp_harness_res(double *res6);
 const char *qp_harness_status_message(int status);
@@ -186,11 +188,15 @@ class Harness:
         self.lib.qp_harness_set_zero()
 
     @classmethod
-    def build(cls, out_dir: Path, N: int, NG: int, real: str = "double", cc: str = "gcc") -> Harness:
+    def build(cls, out_dir: Path, N: int, NG: int, real: str = "double", cc: str = "gcc",
+              rows: int | None = None) -> Harness:
+        """rows: soft rows a QP may hold (the solvers' row capacity); None: every row."""
         defines = {"QPT_N": str(N), "QPT_NG": str(NG)}
         if real == "float":
             defines["HM_REAL_IS_FLOAT"] = ""
-        lib = out_dir / f"libqpt_{N}_{NG}_{real}_{cc}.so"
+        if rows is not None:
+            defines["QPT_NRC"] = str(rows)
+        lib = out_dir / f"libqpt_{N}_{NG}_{real}_{cc}{'' if rows is None else f'_r{rows}'}.so"
         compile_c([CDIR / "qp_harness.c"], lib, defines, shared=True, cc=cc, extra=("-Wmissing-prototypes",))
         return cls(lib, N, NG, real)
 
@@ -237,6 +243,17 @@ class Harness:
         self.lib.qp_harness_warm(warm_start, warm_mu)
         status = self.lib.qp_harness_solve()
         return self.result(status)
+
+    def solve_fallback(self, qp: QP, max_iter: int = 0, tol: float = 0.0) -> Result:
+        """Solve qp with the fallback solver alone (the homogeneous embedding, ocp_qp_hsde.h)."""
+        self.load(qp)
+        self.set_arg(max_iter, tol)
+        return self.result(self.lib.qp_harness_solve_fallback())
+
+    @property
+    def rows(self) -> int:
+        """Soft rows a QP may hold (the row capacity the harness was built with)."""
+        return int(self.lib.qp_harness_rows())
 
     def result(self, status: int) -> Result:
         it, polls, flags = (self.ffi.new("int *") for _ in range(3))

@@ -33,6 +33,7 @@ from tests.qp_harness import (
     NUMERICAL,
     NX,
     QP,
+    SOL_FIELDS,
     SOLVED,
     TIMEOUT,
     Array,
@@ -46,6 +47,7 @@ from tests.qp_harness import (
     conic_form,
     kkt_errors,
     make_infeasible,
+    present,
     random_qp,
 )
 
@@ -582,3 +584,51 @@ def test_bench_program_builds_and_solves(build_dir: Path) -> None:
     assert proc.returncode == 0
     lines = proc.stdout.strip().splitlines()
     assert len(lines) == 4 and all("QP solved" in line for line in lines), proc.stdout
+
+
+# ------------------------------------------------------------------------------------------------
+# The row capacity: the solvers' memory for soft rows sized by the rows a QP may hold in all
+# ------------------------------------------------------------------------------------------------
+
+ROW_CAPACITY = 5  # of the N * NG = 18 rows the stages 1..N of these QPs can have
+
+
+@pytest.fixture(scope="session")
+def hq_rows(build_dir: Path) -> Harness:
+    return Harness.build(build_dir, N, NG, rows=ROW_CAPACITY)
+
+
+def _soft_rows(qp: QP) -> int:
+    return sum(int(qp.soft[n, i] != 0 and present(qp.lg[n, i])) for n in range(1, N + 1) for i in range(qp.ng[n]))
+
+
+def test_a_qp_within_the_row_capacity_is_solved_bit_for_bit_as_with_room_for_every_row(
+        hq: Harness, hq_rows: Harness) -> None:
+    assert hq_rows.rows == ROW_CAPACITY and hq.rows == (N + 1) * NG
+    rng = np.random.default_rng(2611)
+    checked = 0
+    for _ in range(300):
+        qp, _, _ = random_qp(rng, N, NG, Shape(soft_fraction=0.9))
+        if _soft_rows(qp) > ROW_CAPACITY or _soft_rows(qp) == 0:
+            continue
+        for solve in ("solve", "solve_fallback"):
+            whole, capped = getattr(hq, solve)(qp), getattr(hq_rows, solve)(qp)
+            assert (capped.status, capped.iter, capped.fallback) == (whole.status, whole.iter, whole.fallback)
+            for f in SOL_FIELDS:
+                np.testing.assert_array_equal(getattr(capped.sol, f), getattr(whole.sol, f), err_msg=f"{solve}: {f}")
+        checked += 1
+    assert checked >= 20
+
+
+def test_a_qp_beyond_the_row_capacity_is_refused_before_any_work(hq: Harness, hq_rows: Harness) -> None:
+    rng = np.random.default_rng(2612)
+    refused = 0
+    for _ in range(100):
+        qp, _, _ = random_qp(rng, N, NG, Shape(soft_fraction=0.9))
+        if _soft_rows(qp) <= ROW_CAPACITY:
+            continue
+        assert hq.solve(qp).status != NONFINITE  # the same QP fits the solver with room for every row
+        for r in (hq_rows.solve(qp), hq_rows.solve_fallback(qp)):
+            assert r.status == NONFINITE and r.iter == 0
+        refused += 1
+    assert refused >= 10

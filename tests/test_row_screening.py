@@ -26,7 +26,9 @@ STRICT = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"]
 
 @pytest.fixture(scope="module")
 def crowd_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return make_solver(tmp_path_factory.mktemp("screen"), {"name": "screen30", "humans": {"max": 30}})
+    # room for every row (51 x 31) in one QP: these tests compare screened QPs with whole ones
+    return make_solver(tmp_path_factory.mktemp("screen"), {"name": "screen30", "humans": {"max": 30},
+                                                           "solver": {"qp_rows": 51 * 31}})
 
 
 def test_every_screened_rti_qp_solution_solves_the_whole_qp(crowd_dir: Path, tmp_path: Path) -> None:
@@ -71,3 +73,36 @@ def test_row_screening_is_a_runtime_parameter_checked_like_the_others(crowd_dir:
     assert solver.params["row_screening"] == 0
     with pytest.raises(ValueError, match="row_screening must be 0 or 1"):
         solver.set_params(row_screening=2)
+
+
+CAPACITY = 60  # distance rows one QP of the capped solver holds, of 51 x 31
+
+
+@pytest.fixture(scope="module")
+def capped_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return make_solver(tmp_path_factory.mktemp("capped"), {"name": "capped30", "humans": {"max": 30},
+                                                           "solver": {"qp_rows": CAPACITY}})
+
+
+def test_a_qp_beyond_its_row_capacity_holds_the_rows_of_smallest_margin_and_the_sqp_the_same_optimum(
+        crowd_dir: Path, capped_dir: Path) -> None:
+    whole, capped = humanmpc.load(crowd_dir), humanmpc.load(capped_dir)
+    solved = 0
+    for seed in range(8):
+        scene = random_scene(np.random.default_rng(5000 + seed), 25)
+        results = []
+        for solver in (whole, capped):
+            solver.set_params(deadline_ms=1e5)
+            solver.reset()
+            # from a cold start nothing is screened: every row of the 25 people near the plan is in the first QP
+            results.append(solver.solve(scene.x0, scene.goal, scene.humans_now, scene.humans_pred, scene.obstacle,
+                                        max_iter=300, tol=1e-9))
+        a, b = results
+        assert a.qp_rows == b.qp_rows > CAPACITY and a.qp_rows_capped == 0 and b.qp_rows_capped >= 1
+        if a.status_name != "solved":  # a scene the SQP does not converge on in 300 iterations (one of eight)
+            continue
+        solved += 1
+        assert b.status_name == "solved"
+        assert b.cost == pytest.approx(a.cost, rel=1e-8)
+        assert np.max(np.abs(b.x - a.x)) <= 1e-6
+    assert solved >= 6

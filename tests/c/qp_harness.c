@@ -1,7 +1,7 @@
 /*
  * qp_harness.c: the QP runtime instantiated with test sizes, exported as plain C functions for the
  * Python tests (cffi ABI mode). Built by tests/qp_harness.py with
- *     -DQPT_N=<stages> -DQPT_NG=<rows per stage> [-DHM_REAL_IS_FLOAT]
+ *     -DQPT_N=<stages> -DQPT_NG=<rows per stage> [-DQPT_NRC=<soft rows a QP may hold>] [-DHM_REAL_IS_FLOAT]
  * One static problem, solution, workspace and options; the Python side writes the problem through
  * a struct layout it declares itself and checks against qp_harness_sizeof().
  */
@@ -15,6 +15,9 @@
 #define HM_NS(x) HM_CONCAT(qpt_, x)
 #define HM_N QPT_N
 #define HM_NG QPT_NG
+#ifdef QPT_NRC
+#define HM_NRC QPT_NRC
+#endif
 #include "hm_types.h"
 typedef HM_REAL hm_real;
 #include "hm_aliases.h"
@@ -34,6 +37,8 @@ int qp_harness_check(void);
 void qp_harness_arg(int max_iter, double tol, double tol_infeas, int stop_after, int polish);
 void qp_harness_warm(int warm_start, double warm_mu);
 int qp_harness_solve(void);
+int qp_harness_solve_fallback(void);
+int qp_harness_rows(void);
 int qp_harness_info(int *iter, int *polls, int *flags, double *res6, double *scaled3, double *mtk3);
 void qp_harness_res(double *res6);
 const char *qp_harness_status_message(int status);
@@ -126,6 +131,22 @@ int qp_harness_solve(void)
 {
     g_polls = 0;
     return ocp_qp_ipm_solve(&g_qp, &g_sol, &g_ws, &g_arg);
+}
+
+/* The fallback solver alone (ocp_qp_hsde.h), reported as a solve of the workspace by the fallback. */
+int qp_harness_solve_fallback(void)
+{
+    const int status = ocp_qp_hsde_solve(&g_qp, &g_sol, &g_ws.u.hsde, &g_arg);
+    g_polls = 0;
+    g_ws.fallback = 1;
+    g_ws.out = g_ws.u.hsde.out;
+    return status;
+}
+
+/* Soft rows a QP may hold (HM_QP_NRC: QPT_NRC, by default every row). */
+int qp_harness_rows(void)
+{
+    return HM_QP_NRC;
 }
 
 static void qp_harness_copy_res(const hm_ocp_qp_res *res, double *res6)
