@@ -188,7 +188,7 @@ static int ocp_nlp_keep_capacity(hm_solver *s, int at_step, int present)
 {
     hm_ocp_qp *qp = &s->qp;
     hm_real lo = HM_INF, hi = -HM_INF;
-    int n, j, kept = 0, out = 0, it;
+    int n, j, kept = 0, out = 0, it, room;
     if (present > s->qp_rows_max) s->qp_rows_max = present;
     if (present <= HM_QP_NRC) return 0;
     for (n = 1; n <= HM_N; n++) {
@@ -201,19 +201,26 @@ static int ocp_nlp_keep_capacity(hm_solver *s, int at_step, int present)
             if (m > hi) hi = m;
         }
     }
-    /* count(margin <= lo) <= capacity < count(margin <= hi), but for ties at lo */
-    for (it = 0; it < 64; it++) {
+    /* count(margin <= lo) <= capacity < count(margin <= hi) (but for ties at the smallest margin); a
+     * threshold that keeps exactly the capacity ends the search, and so does a bracket below 1e-6 m:
+     * the rows within it fill what room is left, in order */
+    for (it = 0; it < 40 && hi - lo > HM_R(1e-6); it++) {
         const hm_real mid = lo + (hi - lo) * HM_R(0.5);
-        if (!(mid > lo && mid < hi)) break;
-        if (ocp_nlp_rows_within(s, at_step, mid) <= HM_QP_NRC) lo = mid;
+        const int within = ocp_nlp_rows_within(s, at_step, mid);
+        if (within <= HM_QP_NRC) lo = mid;
         else hi = mid;
+        if (within == HM_QP_NRC) break;
     }
+    room = HM_QP_NRC - ocp_nlp_rows_within(s, at_step, lo);
     for (n = 1; n <= HM_N; n++) {
         const hm_real dp0 = at_step ? s->mult.x[n][0] : HM_R(0.0), dp1 = at_step ? s->mult.x[n][1] : HM_R(0.0);
         for (j = 0; j < qp->ng[n]; j++) {
             const hm_real lg = qp->lg[n][j];
+            hm_real m;
             if (!ocp_qp_bound_present(lg)) continue;
-            if (ocp_nlp_row_margin(qp, n, j, dp0, dp1) <= lo && kept < HM_QP_NRC) {
+            m = ocp_nlp_row_margin(qp, n, j, dp0, dp1);
+            if (kept < HM_QP_NRC && (m <= lo || (m <= hi && room > 0))) {
+                room -= m > lo;
                 kept++;
                 continue;
             }

@@ -5,6 +5,8 @@
 # solver in a crowd of N_h people, all present, for SIM_SECONDS of simulated time, compiled with portable
 # -O2 and counted by valgrind's callgrind (repeatable on a shared machine); the solver struct's size is
 # the closed loop's sizeof of <name>_solver (all memory of a solver: nothing is allocated at run time).
+# The QP row capacity is the spec's default (solver.qp_rows): the table gives it, the most rows a QP of
+# the loop had, and the QPs that had more (they held the rows of smallest margin).
 #
 # usage (from the repository root, after `make venv`): docs/scaling_table.sh
 #        SIM_SECONDS=10 docs/scaling_table.sh "10 50 5" "10 200 5"     # rows "N_h N T"
@@ -19,8 +21,8 @@ if [ $# -eq 0 ]; then
   set -- "5 50 5" "10 50 5" "30 50 5" "60 50 5" "100 50 5" \
          "10 25 5" "10 100 5" "10 200 5" "10 25 2.5" "10 100 10" "10 200 20"
 fi
-printf '| N_h | N | T [s] | dt [s] | solver struct, double [B] | float [B] | instructions / RTI step | QP iterations / step | steps |\n'
-printf '|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n'
+printf '| N_h | N | T [s] | dt [s] | QP rows: capacity / most / QPs beyond | solver struct, double [B] | float [B] | instructions / RTI step | QP iterations / step | steps |\n'
+printf '|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n'
 for row in "$@"; do
   read -r k n T <<< "$row"
   dt=$(awk -v T="$T" -v n="$n" 'BEGIN { printf "%.17g", T / n }')
@@ -40,7 +42,9 @@ for row in "$@"; do
   "$work/loop_$f" 1 1 100000 fixed > "$work/out_$f.json"
   total=$(callgrind_annotate "$work/cg_$d" | awk '/PROGRAM TOTALS/ {gsub(",", "", $1); print $1}')
   field() { sed -n "s/.*\"$1\": \"*\([0-9a-f.]*\).*/\1/p" "$2"; }
-  printf '| %s | %s | %s | %s | %s | %s | %s | %s | %s |\n' "$k" "$n" "$T" "$(awk -v x="$dt" 'BEGIN { printf "%g", x }')" \
+  cap=$(sed -n "s/^#define ${d^^}_QP_ROWS \([0-9]*\).*/\1/p" "$work/$d/$d.h")
+  printf '| %s | %s | %s | %s | %s / %s / %s | %s | %s | %s | %s | %s |\n' "$k" "$n" "$T" "$(awk -v x="$dt" 'BEGIN { printf "%g", x }')" \
+    "$cap" "$(field qp_rows_max "$work/out_$d.json")" "$(field qp_rows_capped "$work/out_$d.json")" \
     "$(field solver_bytes "$work/out_$d.json")" "$(field solver_bytes "$work/out_$f.json")" \
     "$((total / steps))" "$(field qp_iterations_mean "$work/out_$d.json")" "$steps"
 done

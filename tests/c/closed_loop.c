@@ -103,7 +103,7 @@ int main(int argc, char **argv)
     double closest = 1e9;
     const int fixed = argc > 4 && strcmp(argv[4], "fixed") == 0;
     int k = fixed || NH_ALLOC < 5 ? NH_ALLOC : 5, g = 0, j, n;
-    long qp_iterations = 0;
+    long qp_iterations = 0, qp_rows_max = 0, qp_rows_capped = 0;
     unsigned long long xu_hash = 1469598103934665603ULL; /* FNV-1a of x and u at every step: bit-identity checks */
     double total_ms = 0.0, prepare_ms = 0.0;
     rng_state = (unsigned long long)(argc > 2 ? atol(argv[2]) : 1) * 2654435761ULL + 1ULL;
@@ -181,6 +181,8 @@ int main(int argc, char **argv)
         }
         if (out.stop_reason >= 0 && out.stop_reason < n_reasons) counts[out.stop_reason]++;
         qp_iterations += out.qp_iterations;
+        qp_rows_capped += out.qp_rows_capped;
+        if (out.qp_rows > qp_rows_max) qp_rows_max = out.qp_rows;
         if (out.time_total_ms > worst_ms) worst_ms = out.time_total_ms;
         total_ms += out.time_total_ms;
         prepare_ms += out.time_prepare_ms;
@@ -214,6 +216,7 @@ int main(int argc, char **argv)
 #ifdef OCP_QP_IPM_PROFILE
     for (j = 0; j < 7; j++) printf(", \"%s_us\": %.3f", profile_parts[j], 1e-3 * ocp_qp_ipm_profile_ns[j] / (double)steps);
 #endif
+    printf(", \"qp_rows_max\": %ld, \"qp_rows_capped\": %ld", qp_rows_max, qp_rows_capped);
     printf(", \"solver_bytes\": %lu, \"xu_hash\": \"%016llx\"}\n", (unsigned long)sizeof solver, xu_hash);
     return violations > 100 ? 100 : (int)violations;
 }
