@@ -181,16 +181,16 @@ static int ocp_nlp_rows_within(const hm_solver *s, int at_step, hm_real theta)
     return within;
 }
 
-/* Keeps the QP, with present rows in it, within its row capacity (above); returns the rows it left
- * out. The threshold of the kept margins is found by bisection over counts (no sort, no memory: it
+/* Keeps the QP, with *present rows in it, within its row capacity (above), *present counting what it
+ * keeps; returns 1 if it left rows out. The threshold of the kept margins is found by bisection over counts (no sort, no memory: it
  * runs only when the capacity binds); rows at the threshold are kept in order while there is room. */
-static int ocp_nlp_keep_capacity(hm_solver *s, int at_step, int present)
+static int ocp_nlp_keep_capacity(hm_solver *s, int at_step, int *present)
 {
     hm_ocp_qp *qp = &s->qp;
     hm_real lo = HM_INF, hi = -HM_INF;
-    int n, j, kept = 0, out = 0, it, room;
-    if (present > s->qp_rows_max) s->qp_rows_max = present;
-    if (present <= HM_QP_NRC) return 0;
+    int n, j, kept = 0, it, room;
+    if (*present > s->qp_rows_max) s->qp_rows_max = *present;
+    if (*present <= HM_QP_NRC) return 0;
     for (n = 1; n <= HM_N; n++) {
         const hm_real dp0 = at_step ? s->mult.x[n][0] : HM_R(0.0), dp1 = at_step ? s->mult.x[n][1] : HM_R(0.0);
         for (j = 0; j < qp->ng[n]; j++) {
@@ -227,11 +227,11 @@ static int ocp_nlp_keep_capacity(hm_solver *s, int at_step, int present)
             s->screened[n][j] = 1;
             s->screened_lg[n][j] = lg;
             qp->lg[n][j] = -HM_INF;
-            out++;
         }
     }
+    *present = kept;
     s->qp_rows_capped++;
-    return out;
+    return 1;
 }
 
 /* Screening radii of the next QP from the displacements of this QP's step (see above). */
@@ -254,14 +254,12 @@ static void ocp_nlp_size_screening(hm_solver *s)
 HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, const hm_input *in, hm_real tol, int residuals, int shifted, int *qp_iter)
 {
     const int screen = s->params.row_screening && s->screen_radius[0] < HM_INF;
-    int status = HM_QP_MAX_ITER, round, left_out, present, k;
+    int status = HM_QP_MAX_ITER, round, left_out, present, added;
     s->ipm_arg.tol = tol;
     s->ipm_arg.residuals = residuals;
     present = screen ? ocp_nlp_screen_rows(s) : ocp_nlp_rows_within(s, 0, HM_INF);
     /* rows left out by the capacity are checked after the solve as screened rows are, screening or not */
-    k = ocp_nlp_keep_capacity(s, 0, present);
-    present -= k;
-    left_out = k > 0;
+    left_out = ocp_nlp_keep_capacity(s, 0, &present);
     for (round = 0;; round++) {
         s->ipm_arg.max_iter = s->params.qp_max_iter;
         if (s->qp_budget >= 0) {
@@ -288,18 +286,14 @@ HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, const hm_input *in, hm_real tol, int 
                     if (s->screened[n][j] && s->screened_lg[n][j] == -HM_INF) ocp_nlp_evaluate_row(s, in, n, j);
             ocp_nlp_unscreen_rows(s, 0);
             present = ocp_nlp_rows_within(s, 0, HM_INF);
-            k = ocp_nlp_keep_capacity(s, 1, present);
-            present -= k;
-            left_out = k > 0;
+            left_out = ocp_nlp_keep_capacity(s, 1, &present);
             continue;
         }
         if (round > OCP_NLP_SCREEN_ROUNDS) break;
-        k = ocp_nlp_admit_violated_rows(s, in, tol);
-        if (k == 0) break;
-        present += k;
-        k = ocp_nlp_keep_capacity(s, 1, present);
-        present -= k;
-        if (k > 0) left_out = 1;
+        added = ocp_nlp_admit_violated_rows(s, in, tol);
+        if (added == 0) break;
+        present += added;
+        if (ocp_nlp_keep_capacity(s, 1, &present)) left_out = 1;
     }
     if (screen || left_out) ocp_nlp_unscreen_rows(s, &s->mult);
     if (ocp_nlp_qp_usable(status)) ocp_nlp_size_screening(s);

@@ -26,14 +26,15 @@ HM_FUNC hm_real ocp_qp_hsde_tau_pivot(const hm_ocp_qp *restrict qp, const hm_ocp
     hm_real acc = ws->kappa * tinv;
     int n, i, j;
     for (n = 0; n <= HM_N; n++) {
+        const int so = ws->soff[n], ro = ws->roff[n];
         hm_real d[HM_QP_NUX], Hd[HM_QP_NUX];
         for (i = 0; i < HM_QP_NUX; i++) d[i] = v1->ux[n][i] - tinv * v->ux[n][i];
         ocp_qp_hsde_stage_hess_mul(qp, n, ws->cost_scale, d, Hd);
         for (i = 0; i < HM_QP_NUX; i++) acc += d[i] * Hd[i];
         for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[ws->soff[n] + j];
-            const hm_real ds = v1->s[ws->roff[n] + kr] - tinv * v->s[ws->roff[n] + kr];
-            acc += ws->soft_Zl[ws->soff[n] + j] * ds * ds;
+            const int kr = ws->soft_of[so + j];
+            const hm_real ds = v1->s[ro + kr] - tinv * v->s[ro + kr];
+            acc += ws->soft_Zl[so + j] * ds * ds;
         }
     }
     for (j = 0; j < ws->m; j++) acc += v1->z[j] * v1->z[j] * ocp_qp_hsde_weight(ws->t[j], v->z[j], ws->w_max).winv;
@@ -46,10 +47,11 @@ HM_FUNC void ocp_qp_hsde_vec_axpy_except_z(const hm_ocp_qp_hsde_ws *restrict ws,
 {
     int n, i, j;
     for (n = 0; n <= HM_N; n++) {
+        const int so = ws->soff[n], ro = ws->roff[n];
         for (i = 0; i < HM_QP_NUX; i++) y->ux[n][i] += a * x->ux[n][i];
         for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[ws->soff[n] + j];
-            y->s[ws->roff[n] + kr] += a * x->s[ws->roff[n] + kr];
+            const int kr = ws->soft_of[so + j];
+            y->s[ro + kr] += a * x->s[ro + kr];
         }
     }
     for (n = 0; n < HM_N; n++) {
@@ -72,10 +74,11 @@ HM_FUNC hm_real ocp_qp_hsde_direction(const hm_ocp_qp *restrict qp, hm_ocp_qp_hs
     hm_real dtau, a = HM_R(1.0);
     int n, i, j;
     for (n = 0; n <= HM_N; n++) {
+        const int so = ws->soff[n], ro = ws->roff[n];
         for (i = 0; i < HM_QP_NUX; i++) d->ux[n][i] = -keep * r->ux[n][i];
         for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[ws->soff[n] + j];
-            d->s[ws->roff[n] + kr] = -keep * r->s[ws->roff[n] + kr];
+            const int kr = ws->soft_of[so + j];
+            d->s[ro + kr] = -keep * r->s[ro + kr];
         }
     }
     for (n = 0; n < HM_N; n++) {
@@ -125,10 +128,11 @@ HM_FUNC void ocp_qp_hsde_constant_rhs(const hm_ocp_qp_hsde_ws *restrict ws, hm_o
 {
     int n, i, j;
     for (n = 0; n <= HM_N; n++) {
+        const int so = ws->soff[n], ro = ws->roff[n];
         for (i = 0; i < HM_QP_NUX; i++) a->ux[n][i] = -ws->q_ux[n][i];
         for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[ws->soff[n] + j];
-            a->s[ws->roff[n] + kr] = -ws->q_s[ws->roff[n] + kr];
+            const int kr = ws->soft_of[so + j];
+            a->s[ro + kr] = -ws->q_s[ro + kr];
         }
     }
     for (n = 0; n < HM_N; n++) {
@@ -147,6 +151,7 @@ HM_FUNC void ocp_qp_hsde_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_hsde_ws 
     ocp_qp_sol_set_zero(sol);
     for (i = 0; i < HM_NX; i++) sol->x[0][i] = qp->x0[i];
     for (n = 0; n <= HM_N; n++) {
+        const int so = ws->soff[n], ro = ws->roff[n];
         const int off = ws->off[n];
         const int base = off + ws->nb[n];
         const int nr = ws->nr[n];
@@ -169,11 +174,11 @@ HM_FUNC void ocp_qp_hsde_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_hsde_ws 
                 else sol->lam_lbx[n][c - HM_NU] = lam;
             }
         }
-        for (k = 0; k < nr; k++) sol->lam_lg[n][ws->row_idx[ws->roff[n] + k]] = sc * v->z[base + k];
+        for (k = 0; k < nr; k++) sol->lam_lg[n][ws->row_idx[ro + k]] = sc * v->z[base + k];
         for (j = 0; j < ws->ns[n]; j++) {
-            const int kr = ws->soft_of[ws->soff[n] + j];
-            const int i_row = ws->row_idx[ws->roff[n] + kr];
-            sol->s[n][i_row] = sp * v->s[ws->roff[n] + kr];
+            const int kr = ws->soft_of[so + j];
+            const int i_row = ws->row_idx[ro + kr];
+            sol->s[n][i_row] = sp * v->s[ro + kr];
             sol->lam_ls[n][i_row] = sc * v->z[base + nr + j];
         }
     }
@@ -230,9 +235,10 @@ HM_FUNC void ocp_qp_hsde_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
             for (j = 0; j < ws->m; j++) ws->dt[j] = ws->w[j] < ws->w_max ? -d->z[j] / ws->w[j] : HM_R(0.0);
             ocp_qp_hsde_residuals(qp, ws, d, ws->dt, HM_R(1.0), 0, &sm);
             for (n = 0; n <= HM_N; n++) {
+                const int so = ws->soff[n], ro = ws->roff[n];
                 for (i = 0; i < HM_QP_NUX; i++) e->ux[n][i] = -r->ux[n][i];
                 for (j = 0; j < ws->ns[n]; j++) {
-                    const int kr = ws->roff[n] + ws->soft_of[ws->soff[n] + j];
+                    const int kr = ro + ws->soft_of[so + j];
                     e->s[kr] = -r->s[kr];
                 }
             }
@@ -242,9 +248,10 @@ HM_FUNC void ocp_qp_hsde_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_
             for (j = 0; j < ws->m; j++) e->z[j] = -r->z[j];
             ocp_qp_hsde_kkt_solve(qp, ws, e, e);
             for (n = 0; n <= HM_N; n++) {
+                const int so = ws->soff[n], ro = ws->roff[n];
                 for (i = 0; i < HM_QP_NUX; i++) d->ux[n][i] += e->ux[n][i];
                 for (j = 0; j < ws->ns[n]; j++) {
-                    const int kr = ws->roff[n] + ws->soft_of[ws->soff[n] + j];
+                    const int kr = ro + ws->soft_of[so + j];
                     d->s[kr] += e->s[kr];
                 }
             }

@@ -24,6 +24,7 @@ HM_FUNC hm_real ocp_qp_hsde_kkt_pivot_inv(hm_real pivot, hm_real diag)
 HM_FUNC void ocp_qp_hsde_kkt_stage_matrix(const hm_ocp_qp *restrict qp, hm_ocp_qp_hsde_ws *restrict ws, int n,
                                      hm_real *restrict H)
 {
+    const int so = ws->soff[n], ro = ws->roff[n];
     const hm_real *restrict w = ws->w;
     const int off = ws->off[n];
     const int nb = ws->nb[n];
@@ -53,17 +54,17 @@ HM_FUNC void ocp_qp_hsde_kkt_stage_matrix(const hm_ocp_qp *restrict qp, hm_ocp_q
         }
         for (k = 0; k < nr; k++) wrow[k] = w[base + k];
         for (j = 0; j < ns; j++) {
-            const int kr = ws->soft_of[ws->soff[n] + j];
-            const hm_real Zl = ws->soft_Zl[ws->soff[n] + j];
+            const int kr = ws->soft_of[so + j];
+            const hm_real Zl = ws->soft_Zl[so + j];
             const hm_real wsl = w[base + nr + j];
             const hm_real hinv = HM_R(1.0) / (Zl + wrow[kr] + wsl);
-            ws->soft_hinv[ws->soff[n] + j] = hinv;
+            ws->soft_hinv[so + j] = hinv;
             wrow[kr] *= (Zl + wsl) * hinv;
         }
         {
             hm_real h00 = HM_R(0.0), h10 = HM_R(0.0), h11 = HM_R(0.0);
             for (k = 0; k < nr; k++) {
-                const hm_real *restrict d = ws->D[ws->roff[n] + k];
+                const hm_real *restrict d = ws->D[ro + k];
                 const hm_real wd0 = wrow[k] * d[0];
                 h00 += wd0 * d[0];
                 h10 += wd0 * d[1];
@@ -156,6 +157,7 @@ HM_FUNC int ocp_qp_hsde_kkt_factorize(const hm_ocp_qp *restrict qp, hm_ocp_qp_hs
 HM_FUNC void ocp_qp_hsde_kkt_condense(hm_ocp_qp_hsde_ws *restrict ws,
                                  const hm_ocp_qp_hsde_vec *rhs, int n, hm_real *restrict h)
 {
+    const int so = ws->soff[n], ro = ws->roff[n];
     const hm_real *restrict w = ws->w;
     const hm_real *rz = rhs->z;
     const int off = ws->off[n];
@@ -172,13 +174,13 @@ HM_FUNC void ocp_qp_hsde_kkt_condense(hm_ocp_qp_hsde_ws *restrict ws,
         for (k = 0; k < nr; k++) coef[k] = w[base + k] * rz[base + k];
         for (j = 0; j < ns; j++) {
             const int jr = base + nr + j;
-            const int kr = ws->soft_of[ws->soff[n] + j];
-            const hm_real e = (rhs->s[ws->roff[n] + kr] - coef[kr] - w[jr] * rz[jr]) * ws->soft_hinv[ws->soff[n] + j];
-            ws->soft_e[ws->soff[n] + j] = e;
+            const int kr = ws->soft_of[so + j];
+            const hm_real e = (rhs->s[ro + kr] - coef[kr] - w[jr] * rz[jr]) * ws->soft_hinv[so + j];
+            ws->soft_e[so + j] = e;
             coef[kr] += w[base + kr] * e;
         }
         for (k = 0; k < nr; k++) {
-            const hm_real *restrict d = ws->D[ws->roff[n] + k];
+            const hm_real *restrict d = ws->D[ro + k];
             hp0 += coef[k] * d[0];
             hp1 += coef[k] * d[1];
         }
@@ -192,6 +194,7 @@ HM_FUNC void ocp_qp_hsde_kkt_condense(hm_ocp_qp_hsde_ws *restrict ws,
 HM_FUNC void ocp_qp_hsde_kkt_expand(const hm_ocp_qp_hsde_ws *restrict ws,
                                const hm_ocp_qp_hsde_vec *rhs, hm_ocp_qp_hsde_vec *sol, int n)
 {
+    const int so = ws->soff[n], ro = ws->roff[n];
     const hm_real *restrict w = ws->w;
     const hm_real *dux = sol->ux[n];
     const int off = ws->off[n];
@@ -209,15 +212,15 @@ HM_FUNC void ocp_qp_hsde_kkt_expand(const hm_ocp_qp_hsde_ws *restrict ws,
     {
         const hm_real dp0 = dux[HM_NU], dp1 = dux[HM_NU + 1];
         for (k = 0; k < nr; k++) {
-            const hm_real *restrict d = ws->D[ws->roff[n] + k];
+            const hm_real *restrict d = ws->D[ro + k];
             gd[k] = -(d[0] * dp0 + d[1] * dp1);
         }
     }
     for (j = 0; j < ns; j++) {
         const int jr = base + nr + j;
-        const int kr = ws->soft_of[ws->soff[n] + j];
-        const hm_real dsl = ws->soft_e[ws->soff[n] + j] + w[base + kr] * ws->soft_hinv[ws->soff[n] + j] * gd[kr];
-        sol->s[ws->roff[n] + kr] = dsl;
+        const int kr = ws->soft_of[so + j];
+        const hm_real dsl = ws->soft_e[so + j] + w[base + kr] * ws->soft_hinv[so + j] * gd[kr];
+        sol->s[ro + kr] = dsl;
         sol->z[jr] = w[jr] * (-dsl - rhs->z[jr]);
         gd[kr] -= dsl;
     }
@@ -228,14 +231,15 @@ HM_FUNC void ocp_qp_hsde_kkt_expand(const hm_ocp_qp_hsde_ws *restrict ws,
  * c = (ws->c_ux, ws->c_s) and b = (ws->b_eq, ws->b_ineq); evaluated while the stage is in cache. */
 HM_FUNC hm_real ocp_qp_hsde_kkt_tau_row(const hm_ocp_qp_hsde_ws *restrict ws, const hm_ocp_qp_hsde_vec *sol, int n)
 {
+    const int so = ws->soff[n], ro = ws->roff[n];
     const int off = ws->off[n];
     const int nc = ws->nb[n] + ws->nr[n] + ws->ns[n];
     hm_real acc = HM_R(0.0);
     int i, j;
     for (i = 0; i < HM_QP_NUX; i++) acc += ws->c_ux[n][i] * sol->ux[n][i];
     for (j = 0; j < ws->ns[n]; j++) {
-        const int kr = ws->soft_of[ws->soff[n] + j];
-        acc += ws->c_s[ws->roff[n] + kr] * sol->s[ws->roff[n] + kr];
+        const int kr = ws->soft_of[so + j];
+        acc += ws->c_s[ro + kr] * sol->s[ro + kr];
     }
     if (n < HM_N) {
         for (i = 0; i < HM_NX; i++) acc += ws->b_eq[n][i] * sol->y[n][i];

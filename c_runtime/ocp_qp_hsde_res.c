@@ -67,6 +67,7 @@ HM_FUNC void ocp_qp_hsde_residuals(const hm_ocp_qp *restrict qp, hm_ocp_qp_hsde_
     int n, i, j, k;
 
     for (n = 0; n <= HM_N; n++) {
+        const int so = ws->soff[n], ro = ws->roff[n];
         const hm_real *restrict ux = v->ux[n];
         const hm_real *restrict qn = ws->q_ux[n];
         const int off = ws->off[n];
@@ -112,7 +113,7 @@ HM_FUNC void ocp_qp_hsde_residuals(const hm_ocp_qp *restrict qp, hm_ocp_qp_hsde_
             const hm_real p0 = ux[HM_NU], p1 = ux[HM_NU + 1];
             hm_real a0 = HM_R(0.0), a1 = HM_R(0.0);
             for (k = 0; k < nr; k++) {
-                const hm_real *restrict d = ws->D[ws->roff[n] + k];
+                const hm_real *restrict d = ws->D[ro + k];
                 const hm_real zk = v->z[base + k];
                 a0 += d[0] * zk;
                 a1 += d[1] * zk;
@@ -124,16 +125,16 @@ HM_FUNC void ocp_qp_hsde_residuals(const hm_ocp_qp *restrict qp, hm_ocp_qp_hsde_
         }
         for (j = 0; j < ns; j++) {
             const int jr = base + nr + j;
-            const int kr = ws->soft_of[ws->soff[n] + j];
-            const hm_real s = v->s[ws->roff[n] + kr];
-            const hm_real ps = ws->soft_Zl[ws->soff[n] + j] * s;
+            const int kr = ws->soft_of[so + j];
+            const hm_real s = v->s[ro + kr];
+            const hm_real ps = ws->soft_Zl[so + j] * s;
             const hm_real atws = -v->z[base + kr] - v->z[jr];
-            const hm_real rs = ps + atws + ws->q_s[ws->roff[n] + kr] * tau;
-            r->s[ws->roff[n] + kr] = rs;
-            ws->c_s[ws->roff[n] + kr] = ws->q_s[ws->roff[n] + kr] + two_tinv * ps;
+            const hm_real rs = ps + atws + ws->q_s[ro + kr] * tau;
+            r->s[ro + kr] = rs;
+            ws->c_s[ro + kr] = ws->q_s[ro + kr] + two_tinv * ps;
             r->z[base + kr] -= s;
             r->z[jr] = t[jr] - s;
-            qv += ws->q_s[ws->roff[n] + kr] * s;
+            qv += ws->q_s[ro + kr] * s;
             vPv += ps * s;
             atw_n = OCP_QP_HSDE_MAX(atw_n, hm_fabs(atws));
             pv_n = OCP_QP_HSDE_MAX(pv_n, hm_fabs(ps));

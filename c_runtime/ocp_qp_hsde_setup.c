@@ -71,19 +71,19 @@ HM_FUNC int ocp_qp_hsde_setup(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws, int *b
                 /* more rows than the solver holds (HM_QP_HSDE_NGR, HM_QP_NRC; the NLP keeps within them) */
                 if (roff + nr == HM_QP_HSDE_NGR || (qp->soft[n][i] && soff + ns == HM_QP_NRC)) return HM_QP_NONFINITE;
                 ns += qp->soft[n][i] != 0;
-                ws->row_idx[ws->roff[n] + nr] = (unsigned char)i;
-                ws->D[ws->roff[n] + nr][0] = qp->D[n][i][0];
-                ws->D[ws->roff[n] + nr][1] = qp->D[n][i][1];
+                ws->row_idx[roff + nr] = (unsigned char)i;
+                ws->D[roff + nr][0] = qp->D[n][i][0];
+                ws->D[roff + nr][1] = qp->D[n][i][1];
                 ws->b_ineq[m + nb + nr] = -qp->lg[n][i];
                 nr++;
             }
             ns = 0;
             for (k = 0; k < nr; k++) {
-                const int i_row = ws->row_idx[ws->roff[n] + k];
+                const int i_row = ws->row_idx[roff + k];
                 if (!qp->soft[n][i_row]) continue;
-                ws->soft_of[ws->soff[n] + ns] = (unsigned char)k;
+                ws->soft_of[soff + ns] = (unsigned char)k;
                 ws->b_ineq[m + nb + nr + ns] = HM_R(0.0);
-                ws->q_s[ws->roff[n] + k] = qp->zl[n][i_row];
+                ws->q_s[roff + k] = qp->zl[n][i_row];
                 norm_q = OCP_QP_HSDE_MAX(norm_q, hm_fabs(qp->zl[n][i_row]));
                 hscale = OCP_QP_HSDE_MAX(hscale, hm_fabs(qp->Zl[n][i_row]));
                 ns++;
@@ -94,7 +94,7 @@ HM_FUNC int ocp_qp_hsde_setup(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws, int *b
         ws->ns[n] = ns;
         /* the tau row is evaluated by every solve, also those before the first residuals */
         for (i = 0; i < HM_QP_NUX; i++) ws->c_ux[n][i] = HM_R(0.0);
-        for (k = 0; k < nr; k++) ws->c_s[ws->roff[n] + k] = HM_R(0.0);
+        for (k = 0; k < nr; k++) ws->c_s[roff + k] = HM_R(0.0);
         m += nb + nr + ns;
         roff += nr;
         soff += ns;
@@ -137,9 +137,10 @@ HM_FUNC int ocp_qp_hsde_setup(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws, int *b
         const hm_real mag = OCP_QP_HSDE_MAX(hscale, norm_q);
         const hm_real c = HM_R(1.0) / (mag < HM_R(1e-4) ? HM_R(1e-4) : (mag > HM_R(1e4) ? HM_R(1e4) : mag));
         for (n = 0; n <= HM_N; n++) {
+            const int so = ws->soff[n], ro = ws->roff[n];
             for (i = 0; i < HM_QP_NUX; i++) ws->q_ux[n][i] *= c;
-            for (k = 0; k < ws->nr[n]; k++) ws->q_s[ws->roff[n] + k] *= c;
-            for (k = 0; k < ws->ns[n]; k++) ws->soft_Zl[ws->soff[n] + k] = c * qp->Zl[n][ws->row_idx[ws->roff[n] + ws->soft_of[ws->soff[n] + k]]];
+            for (k = 0; k < ws->nr[n]; k++) ws->q_s[ro + k] *= c;
+            for (k = 0; k < ws->ns[n]; k++) ws->soft_Zl[so + k] = c * qp->Zl[n][ws->row_idx[ro + ws->soft_of[so + k]]];
         }
         ws->cost_scale = c;
         ws->norm_q = norm_q * c;
