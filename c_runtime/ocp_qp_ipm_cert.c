@@ -87,7 +87,7 @@ HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws
         const int c0 = n == HM_N ? HM_NU : 0;
         const int c1 = n == 0 ? HM_NU : HM_QP_NUX;
         hm_real Pd[HM_QP_NUX];
-        ocp_qp_ipm_hess_mul(sn, d, Pd);
+        ocp_qp_ipm_hess_mul(qp, n, ws->cost_scale, d, Pd);
         for (i = c0; i < c1; i++) {
             qd += sn->q[i] * d[i];
             pd = OCP_QP_IPM_MAX(pd, OCP_QP_IPM_ABS(Pd[i]));

@@ -31,29 +31,43 @@ typedef char ocp_qp_ipm_nrc_matches[sizeof(((hm_ocp_qp_ipm_ws *)0)->warm.srow) =
 /* The soft rows' passes take the list eight rows at a time (ocp_qp_ipm_rows). */
 #define OCP_QP_IPM_LANES 8
 
-/* y = H_n x for the (scaled) cost Hessian [R S; S' Q] of stage n on (u, x); parts absent at stage 0
- * (x) and stage N (u) are zero in the stage block and in x. */
-HM_KERNEL void ocp_qp_ipm_hess_mul(const hm_ocp_qp_ipm_stage *restrict sn, const hm_real *restrict x,
-                                 hm_real *restrict y)
+/* y = H_n x for the cost Hessian [R S; S' Q] of stage n on (u, x), times the cost scale c; the parts
+ * absent at stage 0 (x) and stage N (u) are zero. The blocks are read from the QP, each entry times c
+ * where it is used: (c * qp->R[n][i]) is the product a per-stage copy of the scaled cost would hold,
+ * so the same numbers without 224 bytes a stage (double) of copies. */
+HM_KERNEL void ocp_qp_ipm_hess_mul(const hm_ocp_qp *restrict qp, int n, hm_real c, const hm_real *restrict x,
+                                   hm_real *restrict y)
 {
-    const hm_real *restrict R = sn->R;
-    const hm_real *restrict S = sn->S;
-    const hm_real *restrict Q = sn->Q;
     const hm_real u0 = x[0], u1 = x[1];
     hm_real yx[HM_NX];
     int i, k;
-    y[0] = R[0] * u0 + R[2] * u1;
-    y[1] = R[1] * u0 + R[3] * u1;
-    for (i = 0; i < HM_NX; i++) yx[i] = Q[i] * x[HM_NU];
-    for (k = 1; k < HM_NX; k++) {
-        const hm_real xk = x[HM_NU + k];
-        for (i = 0; i < HM_NX; i++) yx[i] += Q[i + k * HM_NX] * xk;
+    if (n < HM_N) {
+        const hm_real *restrict R = qp->R[n];
+        y[0] = (c * R[0]) * u0 + (c * R[2]) * u1;
+        y[1] = (c * R[1]) * u0 + (c * R[3]) * u1;
+    } else {
+        y[0] = y[1] = HM_R(0.0);
     }
-    for (k = 0; k < HM_NX; k++) {
-        const hm_real *restrict sk = &S[k * HM_NU];
-        y[0] += sk[0] * x[HM_NU + k];
-        y[1] += sk[1] * x[HM_NU + k];
-        yx[k] += sk[0] * u0 + sk[1] * u1;
+    if (n == 0) {
+        for (i = 0; i < HM_NX; i++) y[HM_NU + i] = HM_R(0.0);
+        return;
+    }
+    {
+        const hm_real *restrict Q = qp->Q[n];
+        for (i = 0; i < HM_NX; i++) yx[i] = (c * Q[i]) * x[HM_NU];
+        for (k = 1; k < HM_NX; k++) {
+            const hm_real xk = x[HM_NU + k];
+            for (i = 0; i < HM_NX; i++) yx[i] += (c * Q[i + k * HM_NX]) * xk;
+        }
+    }
+    if (n < HM_N) {
+        const hm_real *restrict S = qp->S[n];
+        for (k = 0; k < HM_NX; k++) {
+            const hm_real s0 = c * S[k * HM_NU], s1 = c * S[k * HM_NU + 1];
+            y[0] += s0 * x[HM_NU + k];
+            y[1] += s1 * x[HM_NU + k];
+            yx[k] += s0 * u0 + s1 * u1;
+        }
     }
     for (i = 0; i < HM_NX; i++) y[HM_NU + i] = yx[i];
 }

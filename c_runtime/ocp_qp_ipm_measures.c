@@ -105,7 +105,7 @@ HM_FUNC void ocp_qp_ipm_stage_measures(const hm_ocp_qp *restrict qp, hm_ocp_qp_i
         ocp_qp_ipm_bounds_atw(bd, n, atw);
 
         /* stationarity of (u, x): r = P v + q + A' w */
-        ocp_qp_ipm_hess_mul(sn, ux, Pux);
+        ocp_qp_ipm_hess_mul(qp, n, ws->cost_scale, ux, Pux);
         for (i = 0; i < HM_QP_NUX; i++) {
             const hm_real ri = Pux[i] + sn->q[i] + atw[i];
             sn->ha[i] += ri - sn->rv[i];

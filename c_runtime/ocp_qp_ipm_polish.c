@@ -32,7 +32,7 @@ HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm
         const hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
         const hm_real *ux = d->ux[n];
         hm_real r[HM_QP_NUX];
-        ocp_qp_ipm_hess_mul(sn, ux, r);
+        ocp_qp_ipm_hess_mul(qp, n, ws->cost_scale, ux, r);
         for (i = 0; i < HM_QP_NUX; i++) r[i] += sn->q[i];
         if (n < HM_N) {
             const hm_real *B = qp->B[n];

@@ -21,7 +21,7 @@ HM_FUNC int ocp_qp_ipm_pass_b(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *re
     for (n = HM_N; n >= 0; n--) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
         const hm_ocp_qp_ipm_stage *sn1 = n < HM_N ? &ws->u.f.st[n + 1] : sn;
-        if (ocp_qp_kkt_factor_stage(qp, sn, sn1, n)) return HM_QP_NUMERICAL;
+        if (ocp_qp_kkt_factor_stage(qp, sn, sn1, n, ws->cost_scale)) return HM_QP_NUMERICAL;
         ocp_qp_kkt_backward_stage(qp, sn, sn1, n, sn->ha);
     }
     return 0;

@@ -176,10 +176,8 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         off += sn->ns2;
         m += 2 * ns + nh;
 
-        /* cost and dynamics offset, unscaled for now; x_0 is data, its terms move into stage 0 */
-        for (i = 0; i < HM_NU * HM_NU; i++) sn->R[i] = n < HM_N ? qp->R[n][i] : HM_R(0.0);
-        for (i = 0; i < HM_NU * HM_NX; i++) sn->S[i] = (n > 0 && n < HM_N) ? qp->S[n][i] : HM_R(0.0);
-        for (i = 0; i < HM_NX * HM_NX; i++) sn->Q[i] = n > 0 ? qp->Q[n][i] : HM_R(0.0);
+        /* cost gradient and dynamics offset, unscaled for now (the Hessian blocks stay in the QP: the
+         * kernels read them times the cost scale); x_0 is data, its terms move into stage 0 */
         for (i = 0; i < HM_NU; i++) {
             hm_real acc = HM_R(0.0);
             if (n < HM_N) {
@@ -233,13 +231,10 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         ws->w_max = OCP_QP_IPM_W_MAX_REL * OCP_QP_IPM_MAX(HM_R(1.0), hscale * c);
     }
 
-    /* scaled cost, padding rows, starting point: v = 0 (soft slacks satisfying their rows with a
+    /* scaled cost gradient, padding rows, starting point: v = 0 (soft slacks satisfying their rows with a
      * margin of 1), y = 0, t = max(b - a' v, 1), z = 1 / t; zero step */
     for (n = 0; n <= HM_N; n++) {
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
-        for (i = 0; i < HM_NU * HM_NU; i++) sn->R[i] *= c;
-        for (i = 0; i < HM_NU * HM_NX; i++) sn->S[i] *= c;
-        for (i = 0; i < HM_NX * HM_NX; i++) sn->Q[i] *= c;
         for (i = 0; i < HM_QP_NUX; i++) {
             sn->q[i] *= c;
             sn->ux[i] = HM_R(0.0);

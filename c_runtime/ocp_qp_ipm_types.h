@@ -68,9 +68,10 @@ typedef struct HM_NS(ocp_qp_ipm_stage) {
     int ab_int;                       /* 1: a_id, and rows 2 and 3 of [A_n B_n] are two integrators' (the
                                          robot's; ocp_qp_kkt.c: ocp_qp_kkt_factor_stage_integrators) */
     unsigned char hrow[HM_TYPES_NGHP_];          /* QP row of hard row j */
-    /* cost times the cost scale (stage 0: x_0 terms folded into q), dynamics offset (stage 0:
-     * b_0 + A_0 x_0); column-major like ocp_qp */
-    HM_REAL R[HM_NU * HM_NU], S[HM_NU * HM_NX], Q[HM_NX * HM_NX], q[HM_NU + HM_NX], beq[HM_NX];
+    /* cost gradient times the cost scale (stage 0: x_0 terms folded in), dynamics offset (stage 0:
+     * b_0 + A_0 x_0). The Hessian blocks R, S, Q are not copied: the kernels read the QP's times the
+     * cost scale (ocp_qp_kkt_factor_stage, ocp_qp_ipm_hess_mul) */
+    HM_REAL q[HM_NU + HM_NX], beq[HM_NX];
 
     /* hard rows: -d' p + t = -lg */
     HM_REAL hd0[HM_TYPES_NGHP_], hd1[HM_TYPES_NGHP_], hlg[HM_TYPES_NGHP_];

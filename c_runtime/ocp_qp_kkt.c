@@ -73,13 +73,14 @@ HM_KERNEL void ocp_qp_kkt_closed_loop(const hm_ocp_qp *restrict qp, hm_ocp_qp_ip
  * lanes; the same sums written entry by entry made scalar code that was slower although it did
  * less arithmetic (docs/benchmarks.md). */
 HM_FUNC int ocp_qp_kkt_factor_stage_integrators(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn,
-                                                const hm_ocp_qp_ipm_stage *restrict sn1, int n)
+                                                const hm_ocp_qp_ipm_stage *restrict sn1, int n, hm_real c)
 {
     const hm_real *restrict P = sn1->P;
     const hm_real *restrict A = qp->A[n];
     const hm_real *restrict B = qp->B[n];
-    const hm_real *restrict Q = sn->Q;
-    const hm_real *restrict S = sn->S;
+    const hm_real *restrict Q = qp->Q[n];   /* unscaled: every read below is times c */
+    const hm_real *restrict S = qp->S[n];
+    const hm_real *restrict R = qp->R[n];
     const hm_real *restrict Hd = sn->Hd;
     const hm_real *restrict r = sn->ry;
     const hm_real a02 = A[8], a12 = A[9], a03 = A[12], a13 = A[13];
@@ -98,18 +99,18 @@ HM_FUNC int ocp_qp_kkt_factor_stage_integrators(const hm_ocp_qp *restrict qp, hm
         g3[i] = P[i] * a03 + P[4 + i] * a13 + P[12 + i];
     }
     /* the input block */
-    h00 = sn->R[0] + Hd[0] + (b00 * f0[0] + b10 * f0[1] + b30 * f0[3]);
-    h10 = sn->R[1] + (b01 * f0[0] + b11 * f0[1] + b21 * f0[2]);
-    h11 = sn->R[3] + Hd[1] + (b01 * f1[0] + b11 * f1[1] + b21 * f1[2]);
+    h00 = c * R[0] + Hd[0] + (b00 * f0[0] + b10 * f0[1] + b30 * f0[3]);
+    h10 = c * R[1] + (b01 * f0[0] + b11 * f0[1] + b21 * f0[2]);
+    h11 = c * R[3] + Hd[1] + (b01 * f1[0] + b11 * f1[1] + b21 * f1[2]);
     /* the state-input block (S + B' P A)', column j for u_j */
-    x00 = S[0] + f0[0];
-    x10 = S[2] + f0[1];
-    x20 = S[4] + (a02 * f0[0] + a12 * f0[1] + f0[2]);
-    x30 = S[6] + (a03 * f0[0] + a13 * f0[1] + f0[3]);
-    x01 = S[1] + f1[0];
-    x11 = S[3] + f1[1];
-    x21 = S[5] + (a02 * f1[0] + a12 * f1[1] + f1[2]);
-    x31 = S[7] + (a03 * f1[0] + a13 * f1[1] + f1[3]);
+    x00 = c * S[0] + f0[0];
+    x10 = c * S[2] + f0[1];
+    x20 = c * S[4] + (a02 * f0[0] + a12 * f0[1] + f0[2]);
+    x30 = c * S[6] + (a03 * f0[0] + a13 * f0[1] + f0[3]);
+    x01 = c * S[1] + f1[0];
+    x11 = c * S[3] + f1[1];
+    x21 = c * S[5] + (a02 * f1[0] + a12 * f1[1] + f1[2]);
+    x31 = c * S[7] + (a03 * f1[0] + a13 * f1[1] + f1[3]);
     for (i = 0; i < HM_NX; i++) sn->Pry[i] = P[i] * r[0] + P[4 + i] * r[1] + P[8 + i] * r[2] + P[12 + i] * r[3];
     if (ocp_qp_kkt_input_ldl(sn, h00, h10, h11)) return HM_QP_NUMERICAL;
     id0 = sn->Ld[0];
@@ -140,16 +141,16 @@ HM_FUNC int ocp_qp_kkt_factor_stage_integrators(const hm_ocp_qp *restrict qp, hm
     sn->Kx[6] = k1[2];
     sn->Kx[7] = k1[3];
     /* Q + A' P A + the inequalities' diagonal and (px, py) block, minus the Schur terms */
-    q00 = Q[0] + P[0] + Hd[2] + sn->Hpp[0] - c0[0] * k0[0] - c1[0] * k1[0];
-    q10 = Q[1] + P[1] + sn->Hpp[1] - c0[1] * k0[0] - c1[1] * k1[0];
-    q11 = Q[5] + P[5] + Hd[3] + sn->Hpp[2] - c0[1] * k0[1] - c1[1] * k1[1];
-    q20 = Q[2] + g2[0] - c0[2] * k0[0] - c1[2] * k1[0];
-    q21 = Q[6] + g2[1] - c0[2] * k0[1] - c1[2] * k1[1];
-    q30 = Q[3] + g3[0] - c0[3] * k0[0] - c1[3] * k1[0];
-    q31 = Q[7] + g3[1] - c0[3] * k0[1] - c1[3] * k1[1];
-    q22 = Q[10] + Hd[4] + (a02 * g2[0] + a12 * g2[1] + g2[2]) - c0[2] * k0[2] - c1[2] * k1[2];
-    q32 = Q[11] + (a03 * g2[0] + a13 * g2[1] + g2[3]) - c0[3] * k0[2] - c1[3] * k1[2];
-    q33 = Q[15] + Hd[5] + (a03 * g3[0] + a13 * g3[1] + g3[3]) - c0[3] * k0[3] - c1[3] * k1[3];
+    q00 = c * Q[0] + P[0] + Hd[2] + sn->Hpp[0] - c0[0] * k0[0] - c1[0] * k1[0];
+    q10 = c * Q[1] + P[1] + sn->Hpp[1] - c0[1] * k0[0] - c1[1] * k1[0];
+    q11 = c * Q[5] + P[5] + Hd[3] + sn->Hpp[2] - c0[1] * k0[1] - c1[1] * k1[1];
+    q20 = c * Q[2] + g2[0] - c0[2] * k0[0] - c1[2] * k1[0];
+    q21 = c * Q[6] + g2[1] - c0[2] * k0[1] - c1[2] * k1[1];
+    q30 = c * Q[3] + g3[0] - c0[3] * k0[0] - c1[3] * k1[0];
+    q31 = c * Q[7] + g3[1] - c0[3] * k0[1] - c1[3] * k1[1];
+    q22 = c * Q[10] + Hd[4] + (a02 * g2[0] + a12 * g2[1] + g2[2]) - c0[2] * k0[2] - c1[2] * k1[2];
+    q32 = c * Q[11] + (a03 * g2[0] + a13 * g2[1] + g2[3]) - c0[3] * k0[2] - c1[3] * k1[2];
+    q33 = c * Q[15] + Hd[5] + (a03 * g3[0] + a13 * g3[1] + g3[3]) - c0[3] * k0[3] - c1[3] * k1[3];
     Pn[0] = q00;
     Pn[1] = q10;
     Pn[2] = q20;
@@ -171,13 +172,13 @@ HM_FUNC int ocp_qp_kkt_factor_stage_integrators(const hm_ocp_qp *restrict qp, hm
 }
 
 HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_stage *restrict sn,
-                                    const hm_ocp_qp_ipm_stage *restrict sn1, int n)
+                                    const hm_ocp_qp_ipm_stage *restrict sn1, int n, hm_real c)
 {
     hm_real Hxx[HM_NX * HM_NX], Hxu[HM_NX * HM_NU];   /* column-major; Hxu column j for u_j */
     hm_real h00 = HM_R(0.0), h10 = HM_R(0.0), h11 = HM_R(0.0);
     int i, j;
 
-    if (n > 0 && n < HM_N && sn->ab_int) return ocp_qp_kkt_factor_stage_integrators(qp, sn, sn1, n);
+    if (n > 0 && n < HM_N && sn->ab_int) return ocp_qp_kkt_factor_stage_integrators(qp, sn, sn1, n, c);
     if (n < HM_N) {
         const hm_real *restrict P = sn1->P;
         const hm_real *restrict A = qp->A[n];
@@ -185,9 +186,9 @@ HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_
         hm_real FB[HM_NX * HM_NU];   /* P_{n+1} B */
         ocp_qp_kkt_mul4(P, B, FB, HM_NU);
         ocp_qp_kkt_mv4(P, sn->ry, sn->Pry);
-        h00 = sn->R[0] + sn->Hd[0] + ocp_qp_kkt_dot4(B, FB);
-        h10 = sn->R[1] + ocp_qp_kkt_dot4(B + HM_NX, FB);
-        h11 = sn->R[3] + sn->Hd[1] + ocp_qp_kkt_dot4(B + HM_NX, FB + HM_NX);
+        h00 = c * qp->R[n][0] + sn->Hd[0] + ocp_qp_kkt_dot4(B, FB);
+        h10 = c * qp->R[n][1] + ocp_qp_kkt_dot4(B + HM_NX, FB);
+        h11 = c * qp->R[n][3] + sn->Hd[1] + ocp_qp_kkt_dot4(B + HM_NX, FB + HM_NX);
         if (n > 0) {
             hm_real FA[HM_NX * HM_NX];   /* P_{n+1} A */
             if (sn->a_id) {
@@ -197,35 +198,35 @@ HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_
                 ocp_qp_kkt_mul4(P, A + 2 * HM_NX, FA + 2 * HM_NX, 2);
                 for (j = 0; j < HM_NU; j++) {
                     const hm_real *restrict f = FB + j * HM_NX;
-                    Hxu[0 + j * HM_NX] = sn->S[j + 0 * HM_NU] + f[0];
-                    Hxu[1 + j * HM_NX] = sn->S[j + 1 * HM_NU] + f[1];
-                    Hxu[2 + j * HM_NX] = sn->S[j + 2 * HM_NU] + ocp_qp_kkt_dot4(A + 2 * HM_NX, f);
-                    Hxu[3 + j * HM_NX] = sn->S[j + 3 * HM_NU] + ocp_qp_kkt_dot4(A + 3 * HM_NX, f);
+                    Hxu[0 + j * HM_NX] = c * qp->S[n][j + 0 * HM_NU] + f[0];
+                    Hxu[1 + j * HM_NX] = c * qp->S[n][j + 1 * HM_NU] + f[1];
+                    Hxu[2 + j * HM_NX] = c * qp->S[n][j + 2 * HM_NU] + ocp_qp_kkt_dot4(A + 2 * HM_NX, f);
+                    Hxu[3 + j * HM_NX] = c * qp->S[n][j + 3 * HM_NU] + ocp_qp_kkt_dot4(A + 3 * HM_NX, f);
                 }
                 /* lower triangle; (i, j) for i in {0, 1} is F[i, j], for i in {2, 3} a_i' F_j */
                 for (j = 0; j < 2; j++) {
-                    for (i = j; i < 2; i++) Hxx[i + j * HM_NX] = sn->Q[i + j * HM_NX] + FA[i + j * HM_NX];
+                    for (i = j; i < 2; i++) Hxx[i + j * HM_NX] = c * qp->Q[n][i + j * HM_NX] + FA[i + j * HM_NX];
                     /* a_i' P e_j = (P a_i)_j */
-                    Hxx[2 + j * HM_NX] = sn->Q[2 + j * HM_NX] + FA[j + 2 * HM_NX];
-                    Hxx[3 + j * HM_NX] = sn->Q[3 + j * HM_NX] + FA[j + 3 * HM_NX];
+                    Hxx[2 + j * HM_NX] = c * qp->Q[n][2 + j * HM_NX] + FA[j + 2 * HM_NX];
+                    Hxx[3 + j * HM_NX] = c * qp->Q[n][3 + j * HM_NX] + FA[j + 3 * HM_NX];
                 }
-                Hxx[2 + 2 * HM_NX] = sn->Q[2 + 2 * HM_NX] + ocp_qp_kkt_dot4(A + 2 * HM_NX, FA + 2 * HM_NX);
-                Hxx[3 + 2 * HM_NX] = sn->Q[3 + 2 * HM_NX] + ocp_qp_kkt_dot4(A + 3 * HM_NX, FA + 2 * HM_NX);
-                Hxx[3 + 3 * HM_NX] = sn->Q[3 + 3 * HM_NX] + ocp_qp_kkt_dot4(A + 3 * HM_NX, FA + 3 * HM_NX);
+                Hxx[2 + 2 * HM_NX] = c * qp->Q[n][2 + 2 * HM_NX] + ocp_qp_kkt_dot4(A + 2 * HM_NX, FA + 2 * HM_NX);
+                Hxx[3 + 2 * HM_NX] = c * qp->Q[n][3 + 2 * HM_NX] + ocp_qp_kkt_dot4(A + 3 * HM_NX, FA + 2 * HM_NX);
+                Hxx[3 + 3 * HM_NX] = c * qp->Q[n][3 + 3 * HM_NX] + ocp_qp_kkt_dot4(A + 3 * HM_NX, FA + 3 * HM_NX);
             } else {
                 ocp_qp_kkt_mul4(P, A, FA, HM_NX);
                 for (j = 0; j < HM_NU; j++) {
                     for (i = 0; i < HM_NX; i++)
-                        Hxu[i + j * HM_NX] = sn->S[j + i * HM_NU] + ocp_qp_kkt_dot4(A + i * HM_NX, FB + j * HM_NX);
+                        Hxu[i + j * HM_NX] = c * qp->S[n][j + i * HM_NU] + ocp_qp_kkt_dot4(A + i * HM_NX, FB + j * HM_NX);
                 }
                 for (j = 0; j < HM_NX; j++) {
                     for (i = j; i < HM_NX; i++)
-                        Hxx[i + j * HM_NX] = sn->Q[i + j * HM_NX] + ocp_qp_kkt_dot4(A + i * HM_NX, FA + j * HM_NX);
+                        Hxx[i + j * HM_NX] = c * qp->Q[n][i + j * HM_NX] + ocp_qp_kkt_dot4(A + i * HM_NX, FA + j * HM_NX);
                 }
             }
         }
     } else {
-        for (i = 0; i < HM_NX * HM_NX; i++) Hxx[i] = sn->Q[i];
+        for (i = 0; i < HM_NX * HM_NX; i++) Hxx[i] = c * qp->Q[n][i];
     }
     if (n > 0) {
         for (i = 0; i < HM_NX; i++) Hxx[i * (HM_NX + 1)] += sn->Hd[HM_NU + i];
@@ -385,7 +386,8 @@ HM_FUNC int ocp_qp_kkt_factorize(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws)
 {
     int n;
     for (n = HM_N; n >= 0; n--) {
-        if (ocp_qp_kkt_factor_stage(qp, &ws->u.f.st[n], n < HM_N ? &ws->u.f.st[n + 1] : &ws->u.f.st[n], n))
+        if (ocp_qp_kkt_factor_stage(qp, &ws->u.f.st[n], n < HM_N ? &ws->u.f.st[n + 1] : &ws->u.f.st[n], n,
+                                    ws->cost_scale))
             return HM_QP_NUMERICAL;
     }
     return 0;
