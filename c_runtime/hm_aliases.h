@@ -9,6 +9,7 @@ typedef HM_NS(ocp_qp) hm_ocp_qp;
 typedef HM_NS(ocp_qp_sol) hm_ocp_qp_sol;
 typedef HM_NS(ocp_qp_res) hm_ocp_qp_res;
 typedef HM_NS(ocp_qp_ipm_arg) hm_ocp_qp_ipm_arg;
+typedef HM_NS(ocp_qp_ipm_hard) hm_ocp_qp_ipm_hard;
 typedef HM_NS(ocp_qp_ipm_stage) hm_ocp_qp_ipm_stage;
 typedef HM_NS(ocp_qp_ipm_bounds) hm_ocp_qp_ipm_bounds;
 typedef HM_NS(ocp_qp_ipm_rows) hm_ocp_qp_ipm_rows;

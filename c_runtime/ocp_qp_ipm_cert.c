@@ -60,10 +60,10 @@ HM_FUNC int ocp_qp_ipm_farkas_step(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *
             atw_n = OCP_QP_IPM_MAX(atw_n, as);
         }
         for (j = 0; j < sn->nh; j++) {
-            const hm_real zh = ocp_qp_ipm_ray_z(sn->hdz[j]);
-            atw[HM_NU] -= sn->hd0[j] * zh;
-            atw[HM_NU + 1] -= sn->hd1[j] * zh;
-            bw -= sn->hlg[j] * zh;
+            const hm_real zh = ocp_qp_ipm_ray_z(sn->hr->hdz[j]);
+            atw[HM_NU] -= sn->hr->hd0[j] * zh;
+            atw[HM_NU + 1] -= sn->hr->hd1[j] * zh;
+            bw -= sn->hr->hlg[j] * zh;
         }
         for (i = c0; i < c1; i++) atw_n = OCP_QP_IPM_MAX(atw_n, OCP_QP_IPM_ABS(atw[i]));
     }
@@ -114,7 +114,7 @@ HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws
             pd = OCP_QP_IPM_MAX(pd, OCP_QP_IPM_ABS(sr->sZl[row] * sr->sds[row]));
             ad = OCP_QP_IPM_MAX(ad, OCP_QP_IPM_MAX(-(gd + sr->sds[row]), -sr->sds[row]));
         }
-        for (j = 0; j < sn->nh; j++) ad = OCP_QP_IPM_MAX(ad, -(sn->hd0[j] * d[HM_NU] + sn->hd1[j] * d[HM_NU + 1]));
+        for (j = 0; j < sn->nh; j++) ad = OCP_QP_IPM_MAX(ad, -(sn->hr->hd0[j] * d[HM_NU] + sn->hr->hd1[j] * d[HM_NU + 1]));
     }
     return qd < HM_R(0.0) && OCP_QP_IPM_MAX(pd * cinv, ad) <= tol_infeas * -qd * cinv;
 }

@@ -19,8 +19,8 @@ HM_KERNEL void ocp_qp_ipm_rows_atw(const hm_ocp_qp_ipm_stage *restrict sn, const
         atw[HM_NU + 1] -= sr->sd1[j] * sr->sz[j];
     }
     for (j = 0; j < sn->nh2; j++) {
-        atw[HM_NU] -= sn->hd0[j] * sn->hz[j];
-        atw[HM_NU + 1] -= sn->hd1[j] * sn->hz[j];
+        atw[HM_NU] -= sn->hr->hd0[j] * sn->hr->hz[j];
+        atw[HM_NU + 1] -= sn->hr->hd1[j] * sn->hr->hz[j];
     }
 }
 
@@ -235,8 +235,8 @@ HM_FUNC void ocp_qp_ipm_row_measures(const hm_ocp_qp_ipm_ws *restrict ws, ocp_qp
         const hm_real p0 = sn->ux[HM_NU], p1 = sn->ux[HM_NU + 1];
         if (n == 0) continue;
         for (j = 0; j < sn->nh; j++) {
-            const hm_real t = sn->ht[j], z = sn->hz[j];
-            av = OCP_QP_IPM_MAX(av, OCP_QP_IPM_ABS(t - (sn->hd0[j] * p0 + sn->hd1[j] * p1)));
+            const hm_real t = sn->hr->ht[j], z = sn->hr->hz[j];
+            av = OCP_QP_IPM_MAX(av, OCP_QP_IPM_ABS(t - (sn->hr->hd0[j] * p0 + sn->hr->hd1[j] * p1)));
             nt = OCP_QP_IPM_MAX(nt, t);
             ncr = OCP_QP_IPM_MAX(ncr, OCP_QP_IPM_MIN(t, z));
         }

@@ -148,20 +148,20 @@ HM_FUNC void ocp_qp_ipm_pass_a(hm_ocp_qp_ipm_ws *restrict ws, hm_real alpha, ocp
             for (j = 0; j < sn->nh2; j += 2) {
                 for (l = 0; l < 2; l++) {
                     const int q = j + l;
-                    const hm_real msk = sn->hlive[q];
-                    const hm_real t = msk * (sn->ht[q] + alpha * sn->hdt[q]) + (HM_R(1.0) - msk);
-                    const hm_real z = msk * (sn->hz[q] + alpha * sn->hdz[q]) + (HM_R(1.0) - msk);
-                    const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q], lg = sn->hlg[q];
+                    const hm_real msk = sn->hr->hlive[q];
+                    const hm_real t = msk * (sn->hr->ht[q] + alpha * sn->hr->hdt[q]) + (HM_R(1.0) - msk);
+                    const hm_real z = msk * (sn->hr->hz[q] + alpha * sn->hr->hdz[q]) + (HM_R(1.0) - msk);
+                    const hm_real d0 = sn->hr->hd0[q], d1 = sn->hr->hd1[q], lg = sn->hr->hlg[q];
                     const hm_real rho = lg - (d0 * p0 + d1 * p1);
                     const hm_real ia = HM_R(1.0) / (t * z);
                     const hm_real ti = z * ia, zi = t * ia;
                     const hm_real w = OCP_QP_IPM_MIN(z * ti, wmax);
                     const hm_real wr = w * rho, wz = w * zi;
-                    sn->ht[q] = t;
-                    sn->hz[q] = z;
-                    sn->hti[q] = ti;
-                    sn->hzi[q] = zi;
-                    sn->hw[q] = w;
+                    sn->hr->ht[q] = t;
+                    sn->hr->hz[q] = z;
+                    sn->hr->hti[q] = ti;
+                    sn->hr->hzi[q] = zi;
+                    sn->hr->hw[q] = w;
                     h00[l] += w * d0 * d0;
                     h10[l] += w * d0 * d1;
                     h11[l] += w * d1 * d1;

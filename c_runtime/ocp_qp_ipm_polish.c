@@ -76,11 +76,11 @@ HM_FUNC void ocp_qp_ipm_polish_residual(const hm_ocp_qp *qp, const hm_ocp_qp_ipm
             e->zs[n][j] = -(ts - d->s[n][j]);
         }
         for (j = 0; j < sn->nh; j++) {
-            const hm_real gp = sn->hd0[j] * ux[HM_NU] + sn->hd1[j] * ux[HM_NU + 1];
-            const hm_real t = sn->hw[j] < wmax ? -d->zh[n][j] / sn->hw[j] : HM_R(0.0);
-            r[HM_NU] -= sn->hd0[j] * d->zh[n][j];
-            r[HM_NU + 1] -= sn->hd1[j] * d->zh[n][j];
-            e->zh[n][j] = -(t - gp + sn->hlg[j]);
+            const hm_real gp = sn->hr->hd0[j] * ux[HM_NU] + sn->hr->hd1[j] * ux[HM_NU + 1];
+            const hm_real t = sn->hr->hw[j] < wmax ? -d->zh[n][j] / sn->hr->hw[j] : HM_R(0.0);
+            r[HM_NU] -= sn->hr->hd0[j] * d->zh[n][j];
+            r[HM_NU + 1] -= sn->hr->hd1[j] * d->zh[n][j];
+            e->zh[n][j] = -(t - gp + sn->hr->hlg[j]);
         }
         for (i = 0; i < HM_QP_NUX; i++) e->ux[n][i] = -r[i];
     }
@@ -179,7 +179,7 @@ HM_FUNC int ocp_qp_ipm_undecided(const hm_ocp_qp_ipm_ws *ws, hm_real alpha)
                 return 1;
         }
         for (j = 0; j < sn->nh; j++) {
-            if (ocp_qp_ipm_undecided_pair(sn->ht[j], sn->hz[j], sn->hdt[j], sn->hdz[j], alpha)) return 1;
+            if (ocp_qp_ipm_undecided_pair(sn->hr->ht[j], sn->hr->hz[j], sn->hr->hdt[j], sn->hr->hdz[j], alpha)) return 1;
         }
     }
     return 0;
@@ -230,7 +230,7 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
             gs->sws[row] = slack_on ? wmax : w_drop;
         }
         for (j = 0; j < sn->nh; j++)
-            sn->hw[j] = ocp_qp_ipm_polish_active(sn->ht[j], sn->hz[j], sn->hdt[j], sn->hdz[j], alpha) ? wmax : w_drop;
+            sn->hr->hw[j] = ocp_qp_ipm_polish_active(sn->hr->ht[j], sn->hr->hz[j], sn->hr->hdt[j], sn->hr->hdz[j], alpha) ? wmax : w_drop;
     }
     for (round = 0; round < 6 && changed; round++) {
         ocp_qp_kkt_condense_weights(ws);
@@ -257,7 +257,7 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
                 e->zr[n][j] = -sr->slg[row];
                 e->zs[n][j] = HM_R(0.0);
             }
-            for (j = 0; j < sn->nh; j++) e->zh[n][j] = -sn->hlg[j];
+            for (j = 0; j < sn->nh; j++) e->zh[n][j] = -sn->hr->hlg[j];
         }
         ocp_qp_kkt_solve(qp, ws, e, d);
         for (k = 0; k < 2; k++) {
@@ -283,8 +283,8 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
                 gs->sws[row] = ocp_qp_ipm_polish_weight(gs->sws[row], &d->zs[n][j], d->s[n][j], wmax, w_drop, &changed);
             }
             for (j = 0; j < sn->nh; j++) {
-                const hm_real g = sn->hd0[j] * v[HM_NU] + sn->hd1[j] * v[HM_NU + 1] - sn->hlg[j];
-                sn->hw[j] = ocp_qp_ipm_polish_weight(sn->hw[j], &d->zh[n][j], g, wmax, w_drop, &changed);
+                const hm_real g = sn->hr->hd0[j] * v[HM_NU] + sn->hr->hd1[j] * v[HM_NU + 1] - sn->hr->hlg[j];
+                sn->hr->hw[j] = ocp_qp_ipm_polish_weight(sn->hr->hw[j], &d->zh[n][j], g, wmax, w_drop, &changed);
             }
         }
     }

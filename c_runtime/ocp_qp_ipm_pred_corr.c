@@ -88,11 +88,11 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
                 for (j = 0; j < sn->nh2; j += 2) {
                     for (l = 0; l < 2; l++) {
                         const int q = j + l;
-                        const hm_real msk = sn->hlive[q];
-                        const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q];
-                        const hm_real t = sn->ht[q], z = sn->hz[q], w = sn->hw[q], zi = sn->hzi[q];
+                        const hm_real msk = sn->hr->hlive[q];
+                        const hm_real d0 = sn->hr->hd0[q], d1 = sn->hr->hd1[q];
+                        const hm_real t = sn->hr->ht[q], z = sn->hr->hz[q], w = sn->hr->hw[q], zi = sn->hr->hzi[q];
                         const hm_real gd = d0 * dp0 + d1 * dp1;
-                        const hm_real rho = sn->hlg[q] - (d0 * p0 + d1 * p1);
+                        const hm_real rho = sn->hr->hlg[q] - (d0 * p0 + d1 * p1);
                         const hm_real dz = w * (rho - gd);
 #ifdef OCP_QP_IPM_DT_PRIMAL
                         const hm_real dt = gd - (t + rho);
@@ -101,10 +101,10 @@ HM_FUNC void ocp_qp_ipm_pass_c(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws *r
 #endif
                         const hm_real del = dt * dz;
                         const hm_real coef = w * zi * del;
-                        sn->hdel[q] = del;
+                        sn->hr->hdel[q] = del;
                         g0[l] += d0 * coef;
                         g1[l] += d1 * coef;
-                        ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hti[q], -dz * zi));
+                        ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hr->hti[q], -dz * zi));
                         sa[l] += msk * (t * dz + z * dt);
                         sb[l] += msk * del;
                     }
@@ -196,11 +196,11 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
                 for (j = 0; j < sn->nh2; j += 2) {
                     for (l = 0; l < 2; l++) {
                         const int q = j + l;
-                        const hm_real d0 = sn->hd0[q], d1 = sn->hd1[q];
-                        const hm_real t = sn->ht[q], z = sn->hz[q], w = sn->hw[q], zi = sn->hzi[q];
-                        const hm_real cc = smu - kdel * sn->hdel[q];
+                        const hm_real d0 = sn->hr->hd0[q], d1 = sn->hr->hd1[q];
+                        const hm_real t = sn->hr->ht[q], z = sn->hr->hz[q], w = sn->hr->hw[q], zi = sn->hr->hzi[q];
+                        const hm_real cc = smu - kdel * sn->hr->hdel[q];
                         const hm_real gd = d0 * dp0 + d1 * dp1;
-                        const hm_real rho0 = sn->hlg[q] - (d0 * p0 + d1 * p1);
+                        const hm_real rho0 = sn->hr->hlg[q] - (d0 * p0 + d1 * p1);
                         const hm_real dz = w * (rho0 + cc * zi - gd);
 #ifdef OCP_QP_IPM_DT_PRIMAL
                         const hm_real dt = gd - (t + rho0);
@@ -208,9 +208,9 @@ HM_FUNC hm_real ocp_qp_ipm_pass_e(const hm_ocp_qp *restrict qp, hm_ocp_qp_ipm_ws
 #else
                         const hm_real dt = -(t * z - cc + t * dz) * zi;
 #endif
-                        sn->hdz[q] = dz;
-                        sn->hdt[q] = dt;
-                        ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hti[q], -dz * zi));
+                        sn->hr->hdz[q] = dz;
+                        sn->hr->hdt[q] = dt;
+                        ra[l] = OCP_QP_IPM_MAX(ra[l], OCP_QP_IPM_MAX(-dt * sn->hr->hti[q], -dz * zi));
                     }
                 }
                 ratio = OCP_QP_IPM_MAX(ratio, OCP_QP_IPM_MAX(ra[0], ra[1]));

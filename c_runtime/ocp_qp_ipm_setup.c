@@ -137,6 +137,7 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         hm_ocp_qp_ipm_stage *sn = &ws->u.f.st[n];
         int ns = 0, nh = 0;
         sn->soff = off;
+        sn->hr = &ws->u.f.hd[HM_QP_HB(n)];
         /* general rows: soft ones and hard ones, each in QP order */
         if (n > 0) {
             for (i = 0; i < qp->ng[n]; i++) {
@@ -160,11 +161,11 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
                     ns++;
                 } else {
                     if (nh == HM_QP_NGH) return HM_QP_NONFINITE;   /* more hard rows than the solver has room for */
-                    sn->hrow[nh] = (unsigned char)i;
-                    sn->hd0[nh] = qp->D[n][i][0];
-                    sn->hd1[nh] = qp->D[n][i][1];
-                    sn->hlg[nh] = lg;
-                    sn->hlive[nh] = HM_R(1.0);
+                    sn->hr->hrow[nh] = (unsigned char)i;
+                    sn->hr->hd0[nh] = qp->D[n][i][0];
+                    sn->hr->hd1[nh] = qp->D[n][i][1];
+                    sn->hr->hlg[nh] = lg;
+                    sn->hr->hlive[nh] = HM_R(1.0);
                     nh++;
                 }
             }
@@ -258,18 +259,18 @@ HM_FUNC int ocp_qp_ipm_setup(const hm_ocp_qp *qp, hm_ocp_qp_ipm_ws *ws, int *bad
         if (sn->ns & 1) ocp_qp_ipm_rows_absent(sr, sn->soff + sn->ns);   /* the stage's padding row */
         for (j = sn->soff; j < sn->soff + sn->ns; j++) sr->sds[j] = sr->sdt[j] = sr->sdz[j] = sr->sdzs[j] = HM_R(0.0);
         for (j = 0; j < sn->nh; j++) {
-            const hm_real t = OCP_QP_IPM_MAX(-sn->hlg[j], HM_R(1.0));
-            sn->ht[j] = t;
-            sn->hz[j] = HM_R(1.0) / t;
+            const hm_real t = OCP_QP_IPM_MAX(-sn->hr->hlg[j], HM_R(1.0));
+            sn->hr->ht[j] = t;
+            sn->hr->hz[j] = HM_R(1.0) / t;
         }
         if (sn->nh & 1) {
             j = sn->nh;
-            sn->hd0[j] = sn->hd1[j] = HM_R(0.0);
-            sn->hlg[j] = HM_R(-1.0);
-            sn->hlive[j] = HM_R(0.0);
-            sn->ht[j] = sn->hz[j] = HM_R(1.0);
+            sn->hr->hd0[j] = sn->hr->hd1[j] = HM_R(0.0);
+            sn->hr->hlg[j] = HM_R(-1.0);
+            sn->hr->hlive[j] = HM_R(0.0);
+            sn->hr->ht[j] = sn->hr->hz[j] = HM_R(1.0);
         }
-        for (j = 0; j < sn->nh2; j++) sn->hdt[j] = sn->hdz[j] = HM_R(0.0);
+        for (j = 0; j < sn->nh2; j++) sn->hr->hdt[j] = sn->hr->hdz[j] = HM_R(0.0);
     }
     /* the rows' starting multipliers, in vector lanes (a stage's padding row: 1 / 1) */
     {

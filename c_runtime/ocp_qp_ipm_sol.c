@@ -55,7 +55,7 @@ HM_FUNC void ocp_qp_ipm_write_stage(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_
         sol->lam_lg[n][i_row] = sc * zr[j];
         sol->lam_ls[n][i_row] = sc * zs[j];
     }
-    for (j = 0; j < sn->nh; j++) sol->lam_lg[n][sn->hrow[j]] = sc * zh[j];
+    for (j = 0; j < sn->nh; j++) sol->lam_lg[n][sn->hr->hrow[j]] = sc * zh[j];
 }
 
 /* sol := the iterate with the primal part scaled by sp (1) and the multipliers by sc
@@ -81,7 +81,7 @@ HM_FUNC void ocp_qp_ipm_write_sol(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws *w
             zb[k][1] = ws->u.f.bd.z[k][1][n];
         }
         ocp_qp_ipm_write_stage(sn, &ws->u.f.bd, &ws->u.f.sr, n, sol, (const hm_real (*)[2])zb,
-                               &ws->u.f.sr.ss[sn->soff], &ws->u.f.sr.sz[sn->soff], &ws->u.f.sr.szs[sn->soff], sn->hz,
+                               &ws->u.f.sr.ss[sn->soff], &ws->u.f.sr.sz[sn->soff], &ws->u.f.sr.szs[sn->soff], sn->hr->hz,
                                sc, sp);
     }
 }
@@ -114,7 +114,7 @@ HM_FUNC void ocp_qp_ipm_write_sol_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_w
             zs[j] = OCP_QP_IPM_MAX(sr->sdzs[sn->soff + j], HM_R(0.0));
             none[j] = HM_R(0.0);
         }
-        for (j = 0; j < sn->nh; j++) zh[j] = OCP_QP_IPM_MAX(sn->hdz[j], HM_R(0.0));
+        for (j = 0; j < sn->nh; j++) zh[j] = OCP_QP_IPM_MAX(sn->hr->hdz[j], HM_R(0.0));
         ocp_qp_ipm_write_stage(sn, bd, sr, n, sol, (const hm_real (*)[2])zb, none, zr, zs, zh, sc, HM_R(1.0));
     }
 }

@@ -41,8 +41,10 @@
 #endif
 #ifdef HM_NGH
 #define HM_TYPES_NGHP_ (((HM_NGH) + 1) / 2 * 2 + ((HM_NGH) == 0) * 2)
+#define HM_TYPES_NHB_ ((HM_NGH) > 0 ? HM_N + 1 : 1)
 #else
 #define HM_TYPES_NGHP_ ((HM_NG + 1) / 2 * 2)
+#define HM_TYPES_NHB_ (HM_N + 1)
 #endif
 #define HM_TYPES_NNP_ ((HM_N + 8) / 8 * 8)
 #ifdef HM_NRC
@@ -56,6 +58,19 @@
       + 7) / 8 * 8)
 
 
+/* The hard rows of a stage: -d' p + t = -lg, in pairs (an odd count padded with a neutral row, live 0).
+ * Kept apart from the stage so that a solver without hard rows (HM_NGH 0: every generated one) has
+ * one block for all stages (HM_TYPES_NHB_), which no stage writes, instead of a pair of slots in each. */
+typedef struct HM_NS(ocp_qp_ipm_hard) {
+    unsigned char hrow[HM_TYPES_NGHP_];          /* QP row of hard row j */
+    HM_REAL hd0[HM_TYPES_NGHP_], hd1[HM_TYPES_NGHP_], hlg[HM_TYPES_NGHP_];
+    HM_REAL hlive[HM_TYPES_NGHP_];
+    HM_REAL ht[HM_TYPES_NGHP_], hz[HM_TYPES_NGHP_];
+    HM_REAL hdt[HM_TYPES_NGHP_], hdz[HM_TYPES_NGHP_];
+    HM_REAL hw[HM_TYPES_NGHP_], hti[HM_TYPES_NGHP_], hzi[HM_TYPES_NGHP_];
+    HM_REAL hdel[HM_TYPES_NGHP_];
+} HM_NS(ocp_qp_ipm_hard);
+
 /* One stage of the solver: its inequality families, its part of the iterate and of the direction,
  * and its part of the Newton system. Stage n carries (u_n, x_n) as one 6-vector ux (u first; u of
  * stage HM_N and x of stage 0 unused), and y_n, the multiplier of the dynamics from n to n + 1. */
@@ -67,19 +82,11 @@ typedef struct HM_NS(ocp_qp_ipm_stage) {
     int a_id;                         /* 1: the first two columns of A_n are e_0, e_1 */
     int ab_int;                       /* 1: a_id, and rows 2 and 3 of [A_n B_n] are two integrators' (the
                                          robot's; ocp_qp_kkt.c: ocp_qp_kkt_factor_stage_integrators) */
-    unsigned char hrow[HM_TYPES_NGHP_];          /* QP row of hard row j */
+    HM_NS(ocp_qp_ipm_hard) *hr;       /* its hard rows (ocp_qp_ipm_hard; set up by every solve) */
     /* cost gradient times the cost scale (stage 0: x_0 terms folded in), dynamics offset (stage 0:
      * b_0 + A_0 x_0). The Hessian blocks R, S, Q are not copied: the kernels read the QP's times the
      * cost scale (ocp_qp_kkt_factor_stage, ocp_qp_ipm_hess_mul) */
     HM_REAL q[HM_NU + HM_NX], beq[HM_NX];
-
-    /* hard rows: -d' p + t = -lg */
-    HM_REAL hd0[HM_TYPES_NGHP_], hd1[HM_TYPES_NGHP_], hlg[HM_TYPES_NGHP_];
-    HM_REAL hlive[HM_TYPES_NGHP_];
-    HM_REAL ht[HM_TYPES_NGHP_], hz[HM_TYPES_NGHP_];
-    HM_REAL hdt[HM_TYPES_NGHP_], hdz[HM_TYPES_NGHP_];
-    HM_REAL hw[HM_TYPES_NGHP_], hti[HM_TYPES_NGHP_], hzi[HM_TYPES_NGHP_];
-    HM_REAL hdel[HM_TYPES_NGHP_];
 
     /* iterate and step of the stage; ry: right-hand side of the dynamics n -> n + 1 in the Newton
      * system (minus their residual) */
@@ -190,8 +197,8 @@ typedef struct HM_NS(ocp_qp_ipm_warm) {
     unsigned char srow[HM_TYPES_NRC_];           /* soft rows: QP row, */
     HM_REAL st[HM_TYPES_NRC_], sz[HM_TYPES_NRC_];       /* row slack and multiplier, */
     HM_REAL ss[HM_TYPES_NRC_], szs[HM_TYPES_NRC_];      /* s and the multiplier of s >= 0 */
-    unsigned char hrow[HM_N + 1][HM_TYPES_NGHP_];       /* hard rows: QP row, */
-    HM_REAL ht[HM_N + 1][HM_TYPES_NGHP_], hz[HM_N + 1][HM_TYPES_NGHP_];   /* slack and multiplier */
+    unsigned char hrow[HM_TYPES_NHB_][HM_TYPES_NGHP_];  /* hard rows (by stage, as ocp_qp_ipm_hard): QP row, */
+    HM_REAL ht[HM_TYPES_NHB_][HM_TYPES_NGHP_], hz[HM_TYPES_NHB_][HM_TYPES_NGHP_];   /* slack and multiplier */
 } HM_NS(ocp_qp_ipm_warm);
 
 /* All memory of a solve. Only the first block is meant for the caller. */
@@ -210,6 +217,7 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
     union {
         struct {
             HM_NS(ocp_qp_ipm_stage) st[HM_N + 1];
+            HM_NS(ocp_qp_ipm_hard) hd[HM_TYPES_NHB_];   /* stage n's at n (or all at 0: HM_QP_NHB) */
             HM_NS(ocp_qp_ipm_bounds) bd;
             HM_NS(ocp_qp_ipm_rows) sr;
 #ifdef HM_QP_POLISH
@@ -222,6 +230,7 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
 
 #undef HM_TYPES_NBP_
 #undef HM_TYPES_NGHP_
+#undef HM_TYPES_NHB_
 #undef HM_TYPES_NNP_
 #undef HM_TYPES_NRC_
 #undef HM_TYPES_MIN_

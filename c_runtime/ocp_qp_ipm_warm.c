@@ -57,9 +57,9 @@ HM_FUNC void ocp_qp_ipm_warm_keep(hm_ocp_qp_ipm_ws *ws)
         off += sn->ns;
         w->nh[n] = sn->nh;
         for (j = 0; j < sn->nh; j++) {
-            w->hrow[n][j] = sn->hrow[j];
-            w->ht[n][j] = sn->ht[j];
-            w->hz[n][j] = sn->hz[j] * cinv;
+            w->hrow[HM_QP_HB(n)][j] = sn->hr->hrow[j];
+            w->ht[HM_QP_HB(n)][j] = sn->hr->ht[j];
+            w->hz[HM_QP_HB(n)][j] = sn->hr->hz[j] * cinv;
         }
     }
     w->ready = 1;
@@ -116,12 +116,12 @@ HM_FUNC void ocp_qp_ipm_warm_apply(hm_ocp_qp_ipm_ws *ws, int shift)
         {
             int a = 0;
             for (j = 0; j < sn->nh; j++) {
-                const int i = sn->hrow[j];
-                while (a < w->nh[m] && w->hrow[m][a] < i) a++;
+                const int i = sn->hr->hrow[j];
+                while (a < w->nh[m] && w->hrow[HM_QP_HB(m)][a] < i) a++;
                 if (a == w->nh[m]) break;
-                if (w->hrow[m][a] != i) continue;
-                sn->ht[j] = ocp_qp_ipm_warm_floor(w->ht[m][a]);
-                sn->hz[j] = ocp_qp_ipm_warm_floor(w->hz[m][a] * c);
+                if (w->hrow[HM_QP_HB(m)][a] != i) continue;
+                sn->hr->ht[j] = ocp_qp_ipm_warm_floor(w->ht[HM_QP_HB(m)][a]);
+                sn->hr->hz[j] = ocp_qp_ipm_warm_floor(w->hz[HM_QP_HB(m)][a] * c);
             }
         }
     }

@@ -371,10 +371,10 @@ HM_FUNC void ocp_qp_kkt_condense_weights(hm_ocp_qp_ipm_ws *ws)
             h11 += we * sr->sd1[row] * sr->sd1[row];
         }
         for (j = 0; j < sn->nh; j++) {
-            const hm_real wd0 = sn->hw[j] * sn->hd0[j];
-            h00 += wd0 * sn->hd0[j];
-            h10 += wd0 * sn->hd1[j];
-            h11 += sn->hw[j] * sn->hd1[j] * sn->hd1[j];
+            const hm_real wd0 = sn->hr->hw[j] * sn->hr->hd0[j];
+            h00 += wd0 * sn->hr->hd0[j];
+            h10 += wd0 * sn->hr->hd1[j];
+            h11 += sn->hr->hw[j] * sn->hr->hd1[j] * sn->hr->hd1[j];
         }
         sn->Hpp[0] = h00;
         sn->Hpp[1] = h10;
@@ -417,9 +417,9 @@ HM_FUNC void ocp_qp_kkt_condense(hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ipm_bo
         hp1 += coef * sr->sd1[row];
     }
     for (j = 0; j < sn->nh; j++) {
-        const hm_real coef = sn->hw[j] * rhs->zh[n][j];
-        hp0 += coef * sn->hd0[j];
-        hp1 += coef * sn->hd1[j];
+        const hm_real coef = sn->hr->hw[j] * rhs->zh[n][j];
+        hp0 += coef * sn->hr->hd0[j];
+        hp1 += coef * sn->hr->hd1[j];
     }
     h[HM_NU] += hp0;
     h[HM_NU + 1] += hp1;
@@ -448,8 +448,8 @@ HM_FUNC void ocp_qp_kkt_expand(const hm_ocp_qp_ipm_stage *sn, const hm_ocp_qp_ip
         sol->zr[n][j] = gs->swr[row] * (gd - rhs->zr[n][j]);
     }
     for (j = 0; j < sn->nh; j++) {
-        const hm_real gd = -(sn->hd0[j] * dp0 + sn->hd1[j] * dp1);
-        sol->zh[n][j] = sn->hw[j] * (gd - rhs->zh[n][j]);
+        const hm_real gd = -(sn->hr->hd0[j] * dp0 + sn->hr->hd1[j] * dp1);
+        sol->zh[n][j] = sn->hr->hw[j] * (gd - rhs->zh[n][j]);
     }
 }
 

@@ -59,6 +59,10 @@
 #define HM_QP_NGH HM_NG
 #endif
 #define HM_QP_NGHP ((HM_QP_NGH + 1) / 2 * 2 + (HM_QP_NGH == 0) * 2)
+/* Hard-row blocks (ocp_qp_ipm_hard): one a stage, or one for all if no stage may have hard rows; the
+ * block of stage n */
+#define HM_QP_NHB (HM_QP_NGH > 0 ? HM_N + 1 : 1)
+#define HM_QP_HB(n) (HM_QP_NGH > 0 ? (n) : 0)
 
 /* The 2x2 input block and the (px, py) rows are written out for these sizes. */
 typedef char ocp_qp_kkt_sizes_fixed[(HM_NU == 2 && HM_NX == 4 && HM_NP == 2 && HM_NG <= 255) ? 1 : -1];

@@ -276,7 +276,7 @@ int qp_harness_kkt_solve(const hm_real *w, const hm_real *rhs, hm_real *sol)
                 v->zr[n][fam[k]] = rhs[off_z + pos];
                 v->s[n][fam[k]] = rhs[off_s + n * HM_NG + k];
             } else {
-                sn->hw[fam[k]] = w[pos];
+                sn->hr->hw[fam[k]] = w[pos];
                 v->zh[n][fam[k]] = rhs[off_z + pos];
             }
             pos++;
