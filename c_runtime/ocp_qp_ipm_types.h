@@ -213,7 +213,8 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
     HM_REAL norm_q, norm_b;
     int fallback;                     /* the solution came from the fallback solver (ocp_qp_hsde.h) */
     /* the stages and the families (and, with the polish, the general solve's memory); or the
-     * fallback's memory: the fallback starts from scratch, after the interior-point iteration */
+     * fallback's memory: the fallback starts from scratch, after the interior-point iteration; or,
+     * between solves, scratch for the caller */
     union {
         struct {
             HM_NS(ocp_qp_ipm_stage) st[HM_N + 1];
@@ -225,6 +226,10 @@ typedef struct HM_NS(ocp_qp_ipm_ws) {
 #endif
         } f;
         HM_NS(ocp_qp_hsde_ws) hsde;
+        /* free between solves (a solve sets up all it reads here; only warm outlives one): the NLP's row
+         * capacity keeps the margins of a QP's rows here while it picks them (ocp_nlp_screen.c). At most
+         * HM_N HM_NG reals, below the size of the union but for the largest sizes */
+        HM_REAL scratch[HM_N * HM_NG];
     } u;
 } HM_NS(ocp_qp_ipm_ws);
 
