@@ -35,7 +35,9 @@ typedef char ocp_qp_ipm_nrc_matches[sizeof(((hm_ocp_qp_ipm_ws *)0)->warm.srow) =
 /* y = H_n x for the cost Hessian [R S; S' Q] of stage n on (u, x), times the cost scale c; the parts
  * absent at stage 0 (x) and stage N (u) are zero. The blocks are read from the QP, each entry times c
  * where it is used: (c * qp->R[n][i]) is the product a per-stage copy of the scaled cost would hold,
- * so the same numbers without 224 bytes a stage (double) of copies. */
+ * so the same numbers without 224 bytes a stage (double) of copies. The fallback's product
+ * (ocp_qp_hsde_stage_hess_mul) scales after the sums instead: each keeps the rounding its solver's
+ * iterates were made with. */
 HM_KERNEL void ocp_qp_ipm_hess_mul(const hm_ocp_qp *restrict qp, int n, hm_real c, const hm_real *restrict x,
                                    hm_real *restrict y)
 {
