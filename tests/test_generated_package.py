@@ -184,6 +184,8 @@ def test_cli_generate_then_build(tmp_path: Path, capsys: pytest.CaptureFixture[s
                                                 "iterate, parameters, the rest")]
     assert len(top) == 6 and sum(top) == total, lines
     assert lines["fallback (shares the above)"] <= lines["QP workspace (interior point | fallback)"]
+    ipm = [v for k, v in lines.items() if k.startswith("interior point: ")]
+    assert len(ipm) == 4 and sum(ipm) <= lines["QP workspace (interior point | fallback)"], lines
 
 
 @pytest.mark.parametrize("command", [[], ["check"], ["generate"], ["build"], ["info"], ["keys"], ["bench"],
