@@ -114,7 +114,8 @@ HM_FUNC int ocp_qp_ipm_unbounded_ray(const hm_ocp_qp *qp, const hm_ocp_qp_ipm_ws
             pd = OCP_QP_IPM_MAX(pd, OCP_QP_IPM_ABS(sr->sZl[row] * sr->sds[row]));
             ad = OCP_QP_IPM_MAX(ad, OCP_QP_IPM_MAX(-(gd + sr->sds[row]), -sr->sds[row]));
         }
-        for (j = 0; j < sn->nh; j++) ad = OCP_QP_IPM_MAX(ad, -(sn->hr->hd0[j] * d[HM_NU] + sn->hr->hd1[j] * d[HM_NU + 1]));
+        for (j = 0; j < sn->nh; j++)
+            ad = OCP_QP_IPM_MAX(ad, -(sn->hr->hd0[j] * d[HM_NU] + sn->hr->hd1[j] * d[HM_NU + 1]));
     }
     return qd < HM_R(0.0) && OCP_QP_IPM_MAX(pd * cinv, ad) <= tol_infeas * -qd * cinv;
 }

@@ -17,7 +17,8 @@ typedef char ocp_qp_ipm_nnp_matches[sizeof(((hm_ocp_qp_ipm_bounds *)0)->v[0]) ==
 /* and the bound slots and the hard-row slots per stage */
 typedef char ocp_qp_ipm_nbp_matches[sizeof(((hm_ocp_qp_ipm_bounds *)0)->bc) == HM_QP_NBP ? 1 : -1];
 typedef char ocp_qp_ipm_nghp_matches[sizeof(((hm_ocp_qp_ipm_hard *)0)->hrow) == HM_QP_NGHP ? 1 : -1];
-typedef char ocp_qp_ipm_nhb_matches[sizeof(((hm_ocp_qp_ipm_ws *)0)->u.f.hd) == HM_QP_NHB * sizeof(hm_ocp_qp_ipm_hard) ? 1 : -1];
+typedef char ocp_qp_ipm_nhb_matches[sizeof(((hm_ocp_qp_ipm_ws *)0)->u.f.hd) == HM_QP_NHB * sizeof(hm_ocp_qp_ipm_hard)
+                                    ? 1 : -1];
 typedef char ocp_qp_ipm_nbp_range[HM_QP_NBP >= 1 && HM_QP_NBP <= HM_QP_NUX ? 1 : -1];
 typedef char ocp_qp_ipm_ngh_range[HM_QP_NGH >= 0 && HM_QP_NGH <= HM_NG ? 1 : -1];
 /* and the soft rows a QP may hold: at least one, at most every row */

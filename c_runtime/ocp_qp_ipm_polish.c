@@ -229,8 +229,10 @@ HM_FUNC void ocp_qp_ipm_polish(const hm_ocp_qp *qp, hm_ocp_qp_sol *sol, hm_ocp_q
             gs->swr[row] = row_on ? wmax : w_drop;
             gs->sws[row] = slack_on ? wmax : w_drop;
         }
-        for (j = 0; j < sn->nh; j++)
-            sn->hr->hw[j] = ocp_qp_ipm_polish_active(sn->hr->ht[j], sn->hr->hz[j], sn->hr->hdt[j], sn->hr->hdz[j], alpha) ? wmax : w_drop;
+        for (j = 0; j < sn->nh; j++) {
+            hm_ocp_qp_ipm_hard *h = sn->hr;
+            h->hw[j] = ocp_qp_ipm_polish_active(h->ht[j], h->hz[j], h->hdt[j], h->hdz[j], alpha) ? wmax : w_drop;
+        }
     }
     for (round = 0; round < 6 && changed; round++) {
         ocp_qp_kkt_condense_weights(ws);

@@ -70,10 +70,11 @@ typedef char ocp_qp_kkt_sizes_fixed[(HM_NU == 2 && HM_NX == 4 && HM_NP == 2 && H
 /* Stage n of the factorisation: the stage matrix (the QP's cost Hessian times the cost scale c,
  * sn->Hd, sn->Hpp and, for n < HM_N, the cost-to-go sn1->P of stage n + 1) and its partial LDL' over
  * the inputs: sn->Ld, sn->Kx and, for n > 0, the cost-to-go Hessian sn->P and (n < HM_N) the
- * closed-loop matrix sn->F of the solves. 0, or HM_QP_NUMERICAL if a pivot of the input block is not safely positive (the QP is not
- * strictly convex in u along the current active set, or the weights have overflowed). sn1 is
- * unused for n = HM_N. Also sets sn->Pry = sn1->P sn->ry (n < HM_N), the term of the dynamics'
- * right-hand side that every solve with this factorisation shares. */
+ * closed-loop matrix sn->F of the solves. 0, or HM_QP_NUMERICAL if a pivot of the input block is
+ * not safely positive (the QP is not strictly convex in u along the current active set, or the
+ * weights have overflowed). sn1 is unused for n = HM_N. Also sets sn->Pry = sn1->P sn->ry
+ * (n < HM_N), the term of the dynamics' right-hand side that every solve with this factorisation
+ * shares. */
 HM_FUNC int ocp_qp_kkt_factor_stage(const hm_ocp_qp *qp, hm_ocp_qp_ipm_stage *sn,
                                     const hm_ocp_qp_ipm_stage *sn1, int n, hm_real c);
 
