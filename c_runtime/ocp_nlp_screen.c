@@ -167,18 +167,18 @@ HM_KERNEL hm_real ocp_nlp_row_margin(const hm_ocp_qp *qp, int n, int j, hm_real 
     return qp->D[n][j][0] * dp0 + qp->D[n][j][1] * dp1 - qp->lg[n][j];
 }
 
-/* Rows present in the QP with margin <= theta (at the step of each node if at_step, else at the
- * linearisation point); all present rows with theta = HM_INF. */
-static int ocp_nlp_rows_within(const hm_solver *s, int at_step, hm_real theta)
+/* Rows present in the QP (those whose margin at the linearisation point is a number: as
+ * ocp_nlp_keep_capacity counts them). */
+static int ocp_nlp_rows_present(const hm_solver *s)
 {
     const hm_ocp_qp *qp = &s->qp;
-    int n, j, within = 0;
+    int n, j, present = 0;
     for (n = 1; n <= HM_N; n++) {
-        const hm_real dp0 = at_step ? s->mult.x[n][0] : HM_R(0.0), dp1 = at_step ? s->mult.x[n][1] : HM_R(0.0);
         for (j = 0; j < qp->ng[n]; j++)
-            if (ocp_qp_bound_present(qp->lg[n][j])) within += ocp_nlp_row_margin(qp, n, j, dp0, dp1) <= theta;
+            if (ocp_qp_bound_present(qp->lg[n][j]))
+                present += ocp_nlp_row_margin(qp, n, j, HM_R(0.0), HM_R(0.0)) <= HM_INF;
     }
-    return within;
+    return present;
 }
 
 /* Rows of margin <= theta among the np margins m. */
@@ -270,7 +270,7 @@ HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, const hm_input *in, hm_real tol, int 
     int status = HM_QP_MAX_ITER, round, left_out, present, added;
     s->ipm_arg.tol = tol;
     s->ipm_arg.residuals = residuals;
-    present = screen ? ocp_nlp_screen_rows(s) : ocp_nlp_rows_within(s, 0, HM_INF);
+    present = screen ? ocp_nlp_screen_rows(s) : ocp_nlp_rows_present(s);
     /* rows left out by the capacity are checked after the solve as screened rows are, screening or not */
     left_out = ocp_nlp_keep_capacity(s, 0, &present);
     for (round = 0;; round++) {
@@ -298,7 +298,7 @@ HM_FUNC int ocp_nlp_qp_solve(hm_solver *s, const hm_input *in, hm_real tol, int 
                 for (j = 0; j < s->qp.ng[n]; j++)
                     if (s->screened[n][j] && s->screened_lg[n][j] == -HM_INF) ocp_nlp_evaluate_row(s, in, n, j);
             ocp_nlp_unscreen_rows(s, 0);
-            present = ocp_nlp_rows_within(s, 0, HM_INF);
+            present = ocp_nlp_rows_present(s);
             left_out = ocp_nlp_keep_capacity(s, 1, &present);
             continue;
         }

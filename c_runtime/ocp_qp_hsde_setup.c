@@ -70,24 +70,21 @@ HM_FUNC int ocp_qp_hsde_setup(const hm_ocp_qp *qp, hm_ocp_qp_hsde_ws *ws, int *b
                 if (!ocp_qp_bound_present(qp->lg[n][i])) continue;
                 /* more rows than the solver holds (HM_QP_HSDE_NGR, HM_QP_NRC; the NLP keeps within them) */
                 if (roff + nr == HM_QP_HSDE_NGR || (qp->soft[n][i] && soff + ns == HM_QP_NRC)) return HM_QP_NONFINITE;
-                ns += qp->soft[n][i] != 0;
                 ws->row_idx[roff + nr] = (unsigned char)i;
                 ws->D[roff + nr][0] = qp->D[n][i][0];
                 ws->D[roff + nr][1] = qp->D[n][i][1];
                 ws->b_ineq[m + nb + nr] = -qp->lg[n][i];
+                if (qp->soft[n][i]) {
+                    ws->soft_of[soff + ns] = (unsigned char)nr;
+                    ws->q_s[roff + nr] = qp->zl[n][i];
+                    norm_q = OCP_QP_HSDE_MAX(norm_q, hm_fabs(qp->zl[n][i]));
+                    hscale = OCP_QP_HSDE_MAX(hscale, hm_fabs(qp->Zl[n][i]));
+                    ns++;
+                }
                 nr++;
             }
-            ns = 0;
-            for (k = 0; k < nr; k++) {
-                const int i_row = ws->row_idx[roff + k];
-                if (!qp->soft[n][i_row]) continue;
-                ws->soft_of[soff + ns] = (unsigned char)k;
-                ws->b_ineq[m + nb + nr + ns] = HM_R(0.0);
-                ws->q_s[roff + k] = qp->zl[n][i_row];
-                norm_q = OCP_QP_HSDE_MAX(norm_q, hm_fabs(qp->zl[n][i_row]));
-                hscale = OCP_QP_HSDE_MAX(hscale, hm_fabs(qp->Zl[n][i_row]));
-                ns++;
-            }
+            /* the soft rows' s >= 0 follow the stage's general rows */
+            for (k = 0; k < ns; k++) ws->b_ineq[m + nb + nr + k] = HM_R(0.0);
         }
         ws->nb[n] = nb;
         ws->nr[n] = nr;

@@ -57,9 +57,10 @@ HM_FUNC void ocp_qp_ipm_warm_keep(hm_ocp_qp_ipm_ws *ws)
         off += sn->ns;
         w->nh[n] = sn->nh;
         for (j = 0; j < sn->nh; j++) {
-            w->hrow[HM_QP_HB(n)][j] = sn->hr->hrow[j];
-            w->ht[HM_QP_HB(n)][j] = sn->hr->ht[j];
-            w->hz[HM_QP_HB(n)][j] = sn->hr->hz[j] * cinv;
+            const int hb = HM_QP_HB(n);
+            w->hrow[hb][j] = sn->hr->hrow[j];
+            w->ht[hb][j] = sn->hr->ht[j];
+            w->hz[hb][j] = sn->hr->hz[j] * cinv;
         }
     }
     w->ready = 1;
@@ -114,14 +115,15 @@ HM_FUNC void ocp_qp_ipm_warm_apply(hm_ocp_qp_ipm_ws *ws, int shift)
             }
         }
         {
+            const int hb = HM_QP_HB(m);
             int a = 0;
             for (j = 0; j < sn->nh; j++) {
                 const int i = sn->hr->hrow[j];
-                while (a < w->nh[m] && w->hrow[HM_QP_HB(m)][a] < i) a++;
+                while (a < w->nh[m] && w->hrow[hb][a] < i) a++;
                 if (a == w->nh[m]) break;
-                if (w->hrow[HM_QP_HB(m)][a] != i) continue;
-                sn->hr->ht[j] = ocp_qp_ipm_warm_floor(w->ht[HM_QP_HB(m)][a]);
-                sn->hr->hz[j] = ocp_qp_ipm_warm_floor(w->hz[HM_QP_HB(m)][a] * c);
+                if (w->hrow[hb][a] != i) continue;
+                sn->hr->ht[j] = ocp_qp_ipm_warm_floor(w->ht[hb][a]);
+                sn->hr->hz[j] = ocp_qp_ipm_warm_floor(w->hz[hb][a] * c);
             }
         }
     }
