@@ -6,9 +6,12 @@ evaluation counts them): the scene and crossing, the time, the fault (the evalua
 robot's speed, the person's bearing from the robot's heading, the person's speed, the person's
 distance one second earlier ("unseen" when they were not observed then) and the protective stops of
 that second. Then the counts: events by fault, person-fault events with the robot standing, with a stop
-in the last second, and with the person unseen a second before.
+in the last second, and with the person unseen a second before. Last, each crossing's closest approach
+(what issue 23's median of the minimum distances is taken over): when, the robot's speed, the person's
+bearing and speed, and whether the person had been observed in the period before ("appears": their
+first observation is already the closest).
 
-    .venv/bin/python docs/contact_analysis.py [SCENE ...]     # default: the three scenes, ~3 minutes
+    .venv/bin/python docs/contact_analysis.py [SCENE ...]     # default: the three scenes, under a minute
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ import sys
 import numpy as np
 
 from humanmpc.eval.commands import choose_solver
-from humanmpc.eval.episode import run_episode
+from humanmpc.eval.episode import EpisodeLog, run_episode
 from humanmpc.eval.metrics import MOVING_SPEED, person_distances, rising_edges, robot_at_fault
 from humanmpc.planners.registry import make_planner
 from humanmpc.sim.scenarios import RECORDED_CROSSINGS, make_scenario
@@ -30,6 +33,7 @@ def main() -> None:
     scenes = sys.argv[1:] or list(SCENES)
     config = choose_solver(None, None)
     rows = []
+    closest: list[str] = []
     print("| scene | crossing | t [s] | fault | robot speed [m/s] | bearing [deg] | person's speed [m/s] "
           "| distance 1 s before [m] | stops in that second |")
     print("|---|---:|---:|---|---:|---:|---:|---:|---|")
@@ -40,6 +44,7 @@ def main() -> None:
             contact = person_distances(log.states[:, :2], log.humans, log.present) < touch
             fault = robot_at_fault(log.states, log.humans) & contact
             second = round(1.0 / log.dt)
+            closest.append(closest_row(scene, seed, log))
             for k in range(contact.shape[1]):
                 for e in rising_edges(contact[:, k]):
                     x = log.states[e]
@@ -62,6 +67,24 @@ def main() -> None:
     print(f"person's fault: robot standing in {len(standing)}, of which {sum(r[3] for r in standing)} with a "
           f"protective stop in the second before; person unseen a second before in "
           f"{sum(r[2] is None for r in person)}")
+    print("\n| scene | crossing | min distance [m] | t [s] | robot speed [m/s] | bearing [deg] "
+          "| person's speed [m/s] | observed the period before |")
+    print("|---|---:|---:|---:|---:|---:|---:|---|")
+    print("\n".join(closest))
+
+
+def closest_row(scene: str, seed: int, log: EpisodeLog) -> str:
+    """The crossing's closest approach to anyone, as a table row."""
+    d = person_distances(log.states[:, :2], log.humans, log.present)
+    d = np.where(np.isfinite(d), d, np.inf)
+    e, k = np.unravel_index(int(np.argmin(d)), d.shape)
+    x = log.states[e]
+    rel = log.humans[e, k] - x[:2]
+    bearing = (np.degrees(np.arctan2(rel[1], rel[0]) - x[2]) + 180.0) % 360.0 - 180.0
+    seen = e >= 1 and bool(log.present[e - 1, k])
+    speed = f"{np.linalg.norm(log.humans[e, k] - log.humans[e - 1, k]) / log.dt:.2f}" if seen else "-"
+    return (f"| {scene} | {seed} | {d[e, k]:.2f} | {log.times[e]:.1f} | {x[3]:.2f} | {bearing:.0f} | {speed} "
+            f"| {'yes' if seen else 'no: appears'} |")
 
 
 if __name__ == "__main__":
