@@ -41,10 +41,11 @@ def main() -> None:
         for seed in range(RECORDED_CROSSINGS):
             log = run_episode(make_scenario(scene, seed), make_planner("mpc"), config)
             touch = log.robot.radius + log.robot.human_radius  # the evaluation's contact distance
-            contact = person_distances(log.states[:, :2], log.humans, log.present) < touch
+            distances = person_distances(log.states[:, :2], log.humans, log.present)
+            contact = distances < touch
             fault = robot_at_fault(log.states, log.humans) & contact
             second = round(1.0 / log.dt)
-            closest.append(closest_row(scene, seed, log))
+            closest.append(closest_row(scene, seed, log, distances))
             for k in range(contact.shape[1]):
                 for e in rising_edges(contact[:, k]):
                     x = log.states[e]
@@ -73,10 +74,9 @@ def main() -> None:
     print("\n".join(closest))
 
 
-def closest_row(scene: str, seed: int, log: EpisodeLog) -> str:
-    """The crossing's closest approach to anyone, as a table row."""
-    d = person_distances(log.states[:, :2], log.humans, log.present)
-    d = np.where(np.isfinite(d), d, np.inf)
+def closest_row(scene: str, seed: int, log: EpisodeLog, distances: np.ndarray) -> str:
+    """The crossing's closest approach to anyone (distances: person_distances of the log), as a table row."""
+    d = np.where(np.isfinite(distances), distances, np.inf)
     e, k = np.unravel_index(int(np.argmin(d)), d.shape)
     x = log.states[e]
     rel = log.humans[e, k] - x[:2]
