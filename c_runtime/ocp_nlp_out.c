@@ -152,6 +152,20 @@ HM_FUNC void ocp_nlp_finish(hm_solver *s, const hm_input *in, hm_output *out, in
         for (i = 0; i < HM_NX; i++) s->x0_last[i] = in->x0[i];
 }
 
+HM_FUNC void ocp_nlp_step_counts_reset(hm_solver *s)
+{
+    s->qp_solves = 0;
+    s->qp_rows_max = 0;
+    s->qp_rows_capped = 0;
+}
+
+HM_FUNC void ocp_nlp_step_counts_report(const hm_solver *s, hm_output *out)
+{
+    out->qp_solves = s->qp_solves;
+    out->qp_rows = s->qp_rows_max;
+    out->qp_rows_capped = s->qp_rows_capped;
+}
+
 HM_FUNC void ocp_nlp_clear_output(hm_output *out)
 {
     out->stop = 0;

@@ -20,6 +20,11 @@ HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output
 /* out as before any solving: no stop, status HM_STATUS_SKIPPED, counts and residuals zero. */
 HM_FUNC void ocp_nlp_clear_output(hm_output *out);
 
+/* A step's QP counts (qp_solves, qp_rows_max, qp_rows_capped of the solver): zeroed when the step
+ * starts (the RTI's feedback, the full SQP), copied into out when it ends. */
+HM_FUNC void ocp_nlp_step_counts_reset(hm_solver *s);
+HM_FUNC void ocp_nlp_step_counts_report(const hm_solver *s, hm_output *out);
+
 /* The plan after the command guard, or the protective stop of reason (see ocp_nlp_out.c). */
 HM_FUNC void ocp_nlp_finish(hm_solver *s, const hm_input *in, hm_output *out, int reason);
 

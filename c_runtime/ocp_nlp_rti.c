@@ -81,9 +81,7 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
     const int shifted = s->warm;
     ocp_nlp_start_clock(s, t_start);
     ocp_nlp_clear_output(out);
-    s->qp_solves = 0;
-    s->qp_rows_max = 0;
-    s->qp_rows_capped = 0;
+    ocp_nlp_step_counts_reset(s);
     s->qp_budget = 0;
     out->sqp_iterations = 1;
     /* a whole step: its preparation, just now, checked the same input (s->prepared: it passed) */
@@ -163,9 +161,7 @@ static int ocp_nlp_rti_feedback_from(hm_solver *s, const hm_input *in, hm_output
      * from an older step */
     if (reason != HM_STOP_NONE) s->ipm_ws.warm.ready = 0;
     ocp_nlp_finish(s, in, out, reason); /* the command guard, or the stop */
-    out->qp_solves = s->qp_solves;
-    out->qp_rows = s->qp_rows_max;
-    out->qp_rows_capped = s->qp_rows_capped;
+    ocp_nlp_step_counts_report(s, out);
     out->time_prepare_ms = s->time_prepare_ms;
     out->time_feedback_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t_feedback);
     out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t_start);

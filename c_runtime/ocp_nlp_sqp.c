@@ -67,9 +67,7 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
 {
     int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER, reason, late = 0;
     ocp_nlp_clear_output(out);
-    s->qp_solves = 0;
-    s->qp_rows_max = 0;
-    s->qp_rows_capped = 0;
+    ocp_nlp_step_counts_reset(s);
     s->qp_budget = -1;   /* each of the SQP's QPs its own qp_max_iter */
     reason = ocp_nlp_check_before(s, in, 0);
     if (reason == HM_STOP_NONE && (max_iter < 1 || !(tol > HM_R(0.0) && tol < HM_INF)))
@@ -131,9 +129,7 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
     out->status = status;
     out->qp_status = qp_status;
     out->sqp_iterations = k;
-    out->qp_solves = s->qp_solves;
-    out->qp_rows = s->qp_rows_max;
-    out->qp_rows_capped = s->qp_rows_capped;
+    ocp_nlp_step_counts_report(s, out);
     reason = HM_STOP_NONE;
     if (late) {
         reason = HM_STOP_DEADLINE;
