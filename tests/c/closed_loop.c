@@ -13,6 +13,8 @@
  * reason and an FNV-1a hash of the state and the command of every step (two builds that print the
  * same hash took the same steps bit for bit); the exit status is the number of violated
  * invariants (capped), 0 when none.
+ * Built with -DCLOSED_LOOP_TRACE it prints a line per step to stderr (step, SQP iterations, QP iterations,
+ * QP solves, QP rows, stop reason: docs/step_work.sh).
  * Built with -DOCP_QP_IPM_PROFILE (and _POSIX_C_SOURCE for the clock), it also prints where the
  * steps' time went: the solver's preparation and step timers, and the QP solver's parts
  * (ocp_qp_ipm.c), in microseconds per step (docs/pass_profile.sh).
@@ -157,6 +159,11 @@ int main(int argc, char **argv)
         }
 
         S(solver_step)(&solver, &in, &out);
+#ifdef CLOSED_LOOP_TRACE
+        /* one line per step, for the per-step instruction counts of docs/step_work.sh */
+        fprintf(stderr, "trace %ld %d %d %d %d %d\n", t, out.sqp_iterations, out.qp_iterations, out.qp_solves,
+                out.qp_rows, out.stop_reason);
+#endif
 
         if (!isfinite(out.u0[0]) || !isfinite(out.u0[1]) || !isfinite(out.command[0]) ||
             !isfinite(out.command[1])) {
