@@ -26,7 +26,9 @@ from humanmpc.sim.recorded import (
 from humanmpc.sim.scenarios import (
     RECORDED_CROSSINGS,
     RECORDED_SCENARIOS,
+    RECORDED_TIME_LIMIT,
     SIMULATED_SCENARIOS,
+    V_REF,
     Scenario,
     make_scenario,
     plan_crossings,
@@ -203,10 +205,20 @@ def test_recorded_people_walk_at_walking_speed(name: str, tracks: int, most: int
 
 @needs_data
 @pytest.mark.parametrize("name", RECORDED_SCENARIOS)
-def test_each_recorded_scene_has_eight_crossings_both_ways_at_four_start_times(name: str) -> None:
+def test_each_recorded_scene_has_32_crossings_both_ways_at_16_start_times_a_crossing_apart(name: str) -> None:
     scenes = [make_scenario(name, seed) for seed in range(RECORDED_CROSSINGS)]
     plan = plan_crossings(load_recording(name))
-    assert len({float(s.crowd.t0) for s in scenes if isinstance(s.crowd, RecordedCrowdSpec)}) == 4
+    assert RECORDED_CROSSINGS == 32
+    starts = np.array([float(s.crowd.t0) for s in scenes[::2] if isinstance(s.crowd, RecordedCrowdSpec)])
+    assert starts.size == 16
+    # crossings 0..7: one start time in each quarter of the admissible ones, in order
+    first, last = load_recording(name).duration
+    quarter = (last - RECORDED_TIME_LIMIT - first) / 4
+    np.testing.assert_array_equal(np.floor((starts[:4] - first) / quarter).clip(0, 3), [0, 1, 2, 3])
+    # no two crossings start within one nominal duration (length at v_ref) of each other
+    nominal = np.linalg.norm(plan.ends[1] - plan.ends[0]) / V_REF
+    gaps = np.abs(starts[:, None] - starts[None, :]) + np.eye(starts.size) * 1e9
+    assert gaps.min() >= nominal - 1e-9
     for a, b in zip(scenes[::2], scenes[1::2], strict=True):
         np.testing.assert_allclose(a.robot_start[:2], b.goal[:2])  # the same crossing, the other way
         np.testing.assert_allclose(a.goal[:2], b.robot_start[:2])
@@ -217,15 +229,18 @@ def test_each_recorded_scene_has_eight_crossings_both_ways_at_four_start_times(n
         gaps = np.linalg.norm(s.crowd.positions[:, None] - plan.ends[None], axis=-1)
         assert gaps.size == 0 or gaps.min() >= 1.0  # nobody at either end when the robot sets off
         assert s.crowd.t0 + s.time_limit <= s.crowd.recording.duration[1]  # people all the way
-        assert s.crowd.ids.size >= 2
+        # people walk through it: at least two present on average over its nominal duration
+        along = s.crowd.t0 + np.arange(0.0, nominal, 0.4)
+        assert s.crowd.recording.present(along).sum(axis=-1).mean() >= 2.0
+    assert all(s.crowd.ids.size >= 2 for s in scenes[:8])  # the first eight start among people
     # reproducible
     np.testing.assert_array_equal(make_scenario(name, 3).goal, scenes[3].goal)
 
 
 @needs_data
 def test_a_recorded_scene_has_no_seed_beyond_its_crossings() -> None:
-    with pytest.raises(ValueError, match=r"biwi_hotel has seeds 0\.\.7"):
-        make_scenario("biwi_hotel", 8)
+    with pytest.raises(ValueError, match=r"biwi_hotel has seeds 0\.\.31"):
+        make_scenario("biwi_hotel", 32)
 
 
 @needs_data
@@ -273,15 +288,15 @@ def test_simulate_runs_a_recorded_scene_and_prints_the_attributed_contacts(
 @pytest.mark.parametrize(
     "argv",
     [
-        ["evaluate", "--scenarios", "biwi_eth", "--planners", "dwb", "--seeds", "9"],
-        ["simulate", "--scenario", "biwi_eth", "--planner", "dwb", "--seed", "8"],
-        ["demo", "--scenario", "biwi_eth", "--seed", "8"],
+        ["evaluate", "--scenarios", "biwi_eth", "--planners", "dwb", "--seeds", "33"],
+        ["simulate", "--scenario", "biwi_eth", "--planner", "dwb", "--seed", "32"],
+        ["demo", "--scenario", "biwi_eth", "--seed", "32"],
     ],
 )
 def test_commands_refuse_a_seed_beyond_the_crossings(argv: list[str], capsys: pytest.CaptureFixture[str]) -> None:
     args = _cli().parse_args(argv)
     assert args.func(args) == 2
-    assert "biwi_eth has seeds 0..7" in capsys.readouterr().err
+    assert "biwi_eth has seeds 0..31" in capsys.readouterr().err
 
 
 def test_evaluate_defaults_to_the_simulated_scenarios(monkeypatch: pytest.MonkeyPatch) -> None:
