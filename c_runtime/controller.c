@@ -19,6 +19,10 @@
  *   length), a few SQP iterations from a cold start find the direct one.
  * - the stall: a robot that makes no progress while nothing stops it (a local solution in front of a
  *   person who does not move) is reported as stalled, and a recovery is tried once per stall_time.
+ * - the goal behind: standing with the carrot behind (after an overshoot, or given a goal behind), the OCP
+ *   has no gradient towards turning (turning in place moves no node) and may not back up, so the real-time
+ *   iteration stands for good; a recovery from a turn towards the carrot starts it, and its plan is kept
+ *   when it ends nearer the carrot.
  * - the slow follower: behind a slow walker on the robot's own line the plan that follows is a saddle
  *   of the OCP, symmetric between passing left and right, where SQP iterations from any symmetric
  *   start stay (measured: a person 1.1 m ahead at 0.15 m/s, cost 2467 following, 873 passing). A
@@ -42,6 +46,9 @@
  * the opposite for the next (a lateral step of about v * 0.5 m), then straight on. */
 #define CONTROLLER_NUDGE_OMEGA HM_R(0.5)
 #define CONTROLLER_NUDGE_SECONDS HM_R(1.0)
+/* The turn start of a recovery turns until the carrot is this close to ahead (the cosine of the bearing:
+ * 26 degrees), then drives; the SQP straightens the rest. */
+#define CONTROLLER_TURN_ALIGNED HM_R(0.9)
 
 /* 1 when every input is usable: counts within their capacities, numbers finite and not absurd. */
 static int controller_input_ok(const hm_controller_input *cin)
@@ -135,18 +142,25 @@ static void controller_solver_params(hm_controller *c, const hm_controller_goal 
     }
 }
 
+/* The length of a planned path. */
+static hm_real controller_plan_length(const hm_output *o)
+{
+    hm_real length = HM_R(0.0);
+    int n;
+    for (n = 0; n < HM_N; n++) {
+        const hm_real dx = o->x[n + 1][0] - o->x[n][0], dy = o->x[n + 1][1] - o->x[n][1];
+        length += hm_sqrt(dx * dx + dy * dy);
+    }
+    return length;
+}
+
 /* A planned path of at least loop_min_length metres whose end is nearer its start than loop_ratio
  * times its length. */
 static int controller_is_loop(const hm_params *p, const hm_output *o)
 {
-    hm_real length = HM_R(0.0), dx, dy;
-    int n;
+    hm_real length, dx, dy;
     if (!(p->loop_ratio > HM_R(0.0))) return 0;
-    for (n = 0; n < HM_N; n++) {
-        dx = o->x[n + 1][0] - o->x[n][0];
-        dy = o->x[n + 1][1] - o->x[n][1];
-        length += hm_sqrt(dx * dx + dy * dy);
-    }
+    length = controller_plan_length(o);
     dx = o->x[HM_N][0] - o->x[0][0];
     dy = o->x[HM_N][1] - o->x[0][1];
     return length >= p->loop_min_length && hm_sqrt(dx * dx + dy * dy) < p->loop_ratio * length;
@@ -179,11 +193,77 @@ static void controller_nudge(hm_controller *c)
     s->warm = 1; /* the SQP starts from this plan, not from a standstill guess */
 }
 
-/* A bounded SQP inside the period's deadline (counted from t0), from a cold start, or with sideways
- * from a step to the side. Its plan replaces the real-time iteration's when it is solved and safe (and
- * with sideways, costs less); otherwise the real-time iteration's stands (it passed the monitors) and
- * the next period starts cold. Returns 1 when it replaced it. */
-static int controller_recover(hm_controller *c, unsigned long long t0, int sideways, hm_controller_output *out)
+/* The bearing of the carrot from a robot at x, in (-pi, pi]. */
+static hm_real controller_carrot_bearing(const hm_input *in, const hm_real *x)
+{
+    const hm_real e = hm_atan2(in->goal[1] - x[1], in->goal[0] - x[0]) - x[2];
+    return hm_atan2(hm_sin(e), hm_cos(e));
+}
+
+/* 1 when the carrot is behind the robot (more than 90 degrees off its heading) and the plan stands (its
+ * path shorter than stall_distance): the standstill where the OCP is stuck with a goal behind. At rest,
+ * turning in place moves no node, so the position terms give the turn no gradient, and v >= 0 forbids
+ * backing up: within the approach (no speed to track) the real-time iteration stays there for good (a
+ * goal 0.66 to 3 m straight behind was never reached), and a recovery from a cold or a sideways start
+ * finds the same standstill. */
+static int controller_stuck_facing_away(const hm_controller *c)
+{
+    return hm_cos(controller_carrot_bearing(&c->in, c->in.x0)) < HM_R(0.0) &&
+           controller_plan_length(&c->out) < c->params.stall_distance;
+}
+
+/* 1 when the point a is nearer the carrot than b. */
+static int controller_nearer(const hm_input *in, const hm_real *a, const hm_real *b)
+{
+    const hm_real ax = in->goal[0] - a[0], ay = in->goal[1] - a[1], bx = in->goal[0] - b[0], by = in->goal[1] - b[1];
+    return ax * ax + ay * ay < bx * bx + by * by;
+}
+
+/* The start of a recovery towards a carrot behind the robot: from the measured state, brake and turn
+ * towards the carrot at the turn-rate bound until it is ahead, then drive to it at the speed the OCP
+ * tracks (at least half the cruising speed), slowing to arrive at rest; simulated by the model. */
+static void controller_turn_start(hm_controller *c)
+{
+    hm_solver *s = &c->solver;
+    const hm_input *in = &c->in;
+    const hm_params *p = &s->params;
+    const hm_real a_min = p->a_bounds[0], a_max = p->a_bounds[1];
+    const hm_real v_goal = hm_fmax(in->goal[3], HM_R(0.5) * c->params.v_ref);
+    int n, i, aligned = 0;
+    for (i = 0; i < HM_NX; i++) s->x[0][i] = in->x0[i];
+    for (n = 0; n < HM_N; n++) {
+        const hm_real *x = s->x[n];
+        const hm_real e = controller_carrot_bearing(in, x);
+        const hm_real dx = in->goal[0] - x[0], dy = in->goal[1] - x[1];
+        const hm_real left = hm_sqrt(dx * dx + dy * dy);
+        hm_real v_want;
+        if (hm_cos(e) > CONTROLLER_TURN_ALIGNED) aligned = 1;
+        v_want = aligned ? hm_fmin(v_goal, hm_sqrt(HM_R(2.0) * -a_min * left)) : HM_R(0.0);
+        s->u[n][0] = hm_fmin(hm_fmax((v_want - x[3]) / HM_R(HM_DT), a_min), a_max);
+        s->u[n][1] = hm_fmin(hm_fmax(e / HM_R(HM_DT), p->omega_bounds[0]), p->omega_bounds[1]);
+        hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], s->qp.A[n], s->qp.B[n]);
+    }
+    s->dyn_fresh = 1;
+    ocp_qp_sol_set_zero(&s->mult);
+    ocp_nlp_screen_reach(s);
+    s->warm = 1;
+}
+
+/* Where a recovery's SQP starts. */
+enum controller_start {
+    CONTROLLER_START_COLD,     /* a standstill guess: after a loop */
+    CONTROLLER_START_SIDEWAYS, /* a step to the side (controller_nudge): slow or stalled */
+    CONTROLLER_START_TURN      /* a turn towards the carrot (controller_turn_start): standing, the carrot behind */
+};
+
+/* A bounded SQP inside the period's deadline (counted from t0), from the given start. Its plan replaces
+ * the real-time iteration's when it is solved and safe, and, from a step to the side, costs less (the
+ * real-time iteration's may be a good plan in another local solution), or, from a turn, ends nearer the
+ * carrot (the real-time iteration's stands where the OCP's cost over the horizon cannot tell a turn
+ * around from standing); otherwise the real-time iteration's stands (it passed the monitors) and the next
+ * period starts cold. Returns 1 when it replaced it. */
+static int controller_recover(hm_controller *c, unsigned long long t0, enum controller_start start,
+                              hm_controller_output *out)
 {
     hm_solver *s = &c->solver;
     const hm_real tol = hm_fmax(s->params.qp_tol, HM_R(1e-6));
@@ -191,10 +271,14 @@ static int controller_recover(hm_controller *c, unsigned long long t0, int sidew
     hm_output *r = &c->recovery_out;
     int ok;
     ocp_nlp_sqp_reset(s);
-    if (sideways) controller_nudge(c);
+    if (start == CONTROLLER_START_TURN) controller_turn_start(c);
+    else if (start == CONTROLLER_START_SIDEWAYS) controller_nudge(c);
     ocp_nlp_sqp_solve_timed(s, &c->in, r, c->params.recovery_iterations, tol, t0);
     out->time_recovery_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t1);
-    ok = !r->stop && r->qp_status == HM_QP_SOLVED && (!sideways || r->cost < c->out.cost);
+    ok = !r->stop && r->qp_status == HM_QP_SOLVED &&
+         (start == CONTROLLER_START_TURN       ? controller_nearer(&c->in, r->x[HM_N], c->out.x[HM_N])
+          : start == CONTROLLER_START_SIDEWAYS ? r->cost < c->out.cost
+                                               : 1);
     if (ok) {
         c->out = *r;
     } else {
@@ -371,14 +455,20 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
     out->time_solver_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t1);
     if (!c->out.stop && c->params.recovery_iterations > 0 && controller_is_loop(&c->params, &c->out)) {
         out->loop_detected = 1;
-        out->recovered = controller_recover(c, t0, 0, out);
+        out->recovered = controller_recover(c, t0, CONTROLLER_START_COLD, out);
     }
     out->stalled = controller_progress(c, cin, &g, c->out.stop, &slow, out);
+    if (!out->recovered && !c->out.stop && c->params.recovery_iterations > 0 && controller_stuck_facing_away(c) &&
+        (!c->has_recovery || cin->time - c->time_recovery >= c->params.stall_time)) {
+        c->has_recovery = 1;
+        c->time_recovery = cin->time;
+        out->recovered = controller_recover(c, t0, CONTROLLER_START_TURN, out);
+    }
     if ((out->stalled || slow) && !out->recovered && !c->out.stop && c->params.recovery_iterations > 0 &&
         (!c->has_recovery || cin->time - c->time_recovery >= c->params.stall_time)) {
         c->has_recovery = 1;
         c->time_recovery = cin->time;
-        out->recovered = controller_recover(c, t0, 1, out);
+        out->recovered = controller_recover(c, t0, CONTROLLER_START_SIDEWAYS, out);
     }
     /* the OCP sees N_h people; the command must keep its distance from every track */
     if (!c->out.stop) {

@@ -328,3 +328,31 @@ def test_a_loop_after_the_goal_jumps_behind_is_replaced_by_a_recovery_plan(ctl: 
     assert without >= 3
     with_recovery, recovered = loops(10)
     assert recovered >= 1 and with_recovery == 0
+
+
+@pytest.mark.parametrize(("distance", "bearing_deg"), [(0.66, 180.0), (1.0, 180.0), (2.0, 180.0), (3.0, 180.0),
+                                                        (1.0, 135.0), (3.0, 135.0)])
+def test_a_goal_behind_the_robot_within_the_approach_is_reached(ctl: Controller, distance: float,
+                                                               bearing_deg: float) -> None:
+    """At rest with the goal behind, within the approach (v_ref T = 4 m), nobody near: turning in place moves
+    no node of the plan and v >= 0 forbids backing up, so the real-time iterations alone stand still for good
+    (before the turn start, the robot stood stalled at every one of these goals). The controller starts a
+    recovery from a turn towards the goal and gets there, turning once, not circling."""
+    a = np.radians(bearing_deg)
+    goal = (distance * np.cos(a), distance * np.sin(a), 0.0)
+    run = drive(ctl, (0.0, 0.0, 0.0), goal, seconds=15.0)
+    assert run.results[-1].goal_reached
+    assert any(r.recovered for r in run.results)
+    assert run.path_length() < distance + 1.5  # the way there: a turn, then straight on
+    assert len(run.results) * DT < 3.0 + 1.5 * distance
+
+
+def test_a_robot_that_cannot_leave_its_standstill_says_it_is_stalled(ctl: Controller) -> None:
+    """0.4 m straight behind, 0.1 m beyond goal_tolerance: turning around costs the OCP more than the 5 s horizon
+    of standing 0.4 m off, and the recovery from a turn goes back to standing. The controller does not pretend:
+    after stall_time it reports the robot stalled, and it never drives off."""
+    run = drive(ctl, (0.0, 0.0, 0.0), (-0.4, 0.0, 0.0), seconds=8.0)
+    assert not run.results[-1].goal_reached
+    assert run.results[-1].stalled and run.results[-1].outcome_name == "stalled"
+    assert never_silently_stalled(run, stall_time=5.0)
+    assert np.max(np.abs(run.xy)) < 0.05
