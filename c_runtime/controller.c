@@ -49,6 +49,12 @@
 /* The turn start of a recovery turns until the carrot is this close to ahead (the cosine of the bearing:
  * 26 degrees), then drives; the SQP straightens the rest. */
 #define CONTROLLER_TURN_ALIGNED HM_R(0.9)
+/* The turn in place to a goal pose's heading: its rate per radian of the heading's error, within the
+ * turn-rate bounds (at 2 per second the error halves in 0.35 s once below the bound's reach). */
+#define CONTROLLER_TURN_GAIN HM_R(2.0)
+/* Slower than this a robot counts as standing: it may turn in place at its goal (the evaluation's threshold
+ * of moving, python/eval/metrics.py). */
+#define CONTROLLER_AT_REST HM_R(0.05)
 
 /* 1 when every input is usable: counts within their capacities, numbers finite and not absurd. */
 static int controller_input_ok(const hm_controller_input *cin)
@@ -297,6 +303,48 @@ static void controller_brake(hm_controller *c)
     ocp_nlp_sqp_reset(&c->solver);
 }
 
+/* What the robot does within goal_tolerance of its goal (controller_at_goal). */
+enum controller_at_goal_state {
+    CONTROLLER_GOAL_DONE,    /* the heading is within yaw_goal_tolerance, or there is none to meet: braking */
+    CONTROLLER_GOAL_TURNING, /* braking, then turning in place to the goal's heading */
+    CONTROLLER_GOAL_HELD     /* the turn is due but someone is within d_h: a protective stop */
+};
+
+/* Within goal_tolerance of a goal pose whose heading is more than yaw_goal_tolerance off: brake, then turn
+ * in place towards the heading (the turn rate CONTROLLER_TURN_GAIN times the heading's error, within the
+ * turn-rate bounds), unless someone is within d_h: then the paper's C2 holds it in a protective stop until
+ * they leave. The OCP, cut off at goal_tolerance, would leave the robot facing the way it came (up to 170
+ * degrees off the goal's heading: docs/evaluation.md); nav2's goal checkers test the heading too. A path
+ * without a goal pose has no heading to meet. c->out: the braking plan, with the turn or the stop. */
+static enum controller_at_goal_state controller_at_goal(hm_controller *c, const hm_controller_input *cin,
+                                                        hm_real heading)
+{
+    const hm_params *p = &c->params;
+    hm_output *o = &c->out;
+    hm_real A[HM_NX * HM_NX], B[HM_NX * HM_NU];
+    int n, i;
+    controller_brake(c);
+    if (cin->has_goal != 1 || !(hm_fabs(heading - c->in.x0[2]) > p->yaw_goal_tolerance)) return CONTROLLER_GOAL_DONE;
+    for (i = 0; i < cin->n_tracks; i++) {
+        const hm_real dx = cin->tracks[i][0] - c->in.x0[0], dy = cin->tracks[i][1] - c->in.x0[1];
+        if (dx * dx + dy * dy < p->d_h * p->d_h) {
+            o->stop = 1;
+            o->stop_reason = HM_STOP_HUMAN_TOO_CLOSE;
+            return CONTROLLER_GOAL_HELD;
+        }
+    }
+    for (n = 0; n < HM_N; n++) {
+        /* brake first, then turn: turning while still rolling would swing the robot off the goal */
+        const hm_real w = hm_fabs(o->x[n][3]) < CONTROLLER_AT_REST ? CONTROLLER_TURN_GAIN * (heading - o->x[n][2])
+                                                                   : HM_R(0.0);
+        o->u[n][1] = hm_fmin(hm_fmax(w, p->omega_bounds[0]), p->omega_bounds[1]);
+        hm_model_dynamics(o->x[n], o->u[n], o->x[n + 1], A, B);
+    }
+    o->u0[1] = o->u[0][1];
+    o->command[1] = o->u[0][1];
+    return CONTROLLER_GOAL_TURNING;
+}
+
 /* Progress towards the goal: the distance left must shrink by stall_distance within stall_time; a
  * path that grows (a replanned detour) restarts the measure, not the timer; a protective stop or a
  * new goal restarts both. Returns 1 when stalled; *slow: 1 when the robot has gone slower than half
@@ -430,10 +478,10 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
     in->goal[2] = g.carrot[2];
     controller_solver_params(c, &g);
     if (g.to_final <= c->params.goal_tolerance) {
-        controller_brake(c);
-        controller_report(c, out);
-        out->outcome = HM_OUTCOME_GOAL_REACHED;
-        out->goal_reached = 1;
+        const enum controller_at_goal_state state = controller_at_goal(c, cin, g.final[2]);
+        controller_report(c, out);   /* a held turn: the outcome "stopped", with its reason */
+        if (state == CONTROLLER_GOAL_DONE) out->outcome = HM_OUTCOME_GOAL_REACHED;
+        out->goal_reached = state == CONTROLLER_GOAL_DONE;
         controller_progress(c, cin, &g, 1, &slow, out);
         out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
         return out->outcome;

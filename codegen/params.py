@@ -271,6 +271,10 @@ PARAMS: tuple[Param, ...] = (
     Param("goal_tolerance", "controller.goal_tolerance", "real", 0.3,
           "distance to the final goal at which it counts as reached (the robot then brakes)", unit="m",
           valid=Range(0.0, 100.0, lo_open=True), controller=True),
+    Param("yaw_goal_tolerance", "controller.yaw_goal_tolerance", "real", 0.25,
+          "within goal_tolerance of a goal pose, the robot turns in place until its heading is this close to "
+          "the goal's (3.2, above pi: any heading; a path without a goal pose has none to meet)", unit="rad",
+          valid=Range(0.0, 3.2, lo_open=True), controller=True, paper=3.2),
     Param("approach", "controller.approach", "flag", True,
           "once the horizon reaches the goal: track no speed, weigh the position at every node "
           "(approach_position) and arrive at rest (approach_stop)", controller=True, paper=False),

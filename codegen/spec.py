@@ -277,6 +277,7 @@ class Controller:
     lookahead: float = param("controller.lookahead")
     goal_taper: float = param("controller.goal_taper")
     goal_tolerance: float = param("controller.goal_tolerance")
+    yaw_goal_tolerance: float = param("controller.yaw_goal_tolerance")
     approach: bool = param("controller.approach")
     approach_position: float = param("controller.approach_position")
     approach_stop: float = param("controller.approach_stop")

@@ -339,7 +339,7 @@ def test_a_goal_behind_the_robot_within_the_approach_is_reached(ctl: Controller,
     (before the turn start, the robot stood stalled at every one of these goals). The controller starts a
     recovery from a turn towards the goal and gets there, turning once, not circling."""
     a = np.radians(bearing_deg)
-    goal = (distance * np.cos(a), distance * np.sin(a), 0.0)
+    goal = (distance * np.cos(a), distance * np.sin(a), a)  # facing the way there: no turn at the goal
     run = drive(ctl, (0.0, 0.0, 0.0), goal, seconds=15.0)
     assert run.results[-1].goal_reached
     assert any(r.recovered for r in run.results)
@@ -356,3 +356,40 @@ def test_a_robot_that_cannot_leave_its_standstill_says_it_is_stalled(ctl: Contro
     assert run.results[-1].stalled and run.results[-1].outcome_name == "stalled"
     assert never_silently_stalled(run, stall_time=5.0)
     assert np.max(np.abs(run.xy)) < 0.05
+
+
+@pytest.mark.parametrize("heading_deg", [90.0, 180.0, -135.0])
+def test_at_a_goal_pose_the_robot_turns_in_place_to_its_heading(ctl: Controller, heading_deg: float) -> None:
+    """The goal 3 m ahead with another heading: within goal_tolerance the robot brakes and turns in place until
+    its heading is within yaw_goal_tolerance (0.25 rad) of the goal's; only then is the goal reached. Before,
+    the goal was reached facing the way the robot came (the goal's heading up to 170 degrees off)."""
+    heading = np.radians(heading_deg)
+    run = drive(ctl, (0.0, 0.0, 0.0), (3.0, 0.0, heading), seconds=20.0)
+    last = run.results[-1]
+    assert last.goal_reached
+    assert abs(np.angle(np.exp(1j * (run.states[-1][2] - heading)))) <= 0.25 + 1e-9
+    at_goal = [r for r in run.results if not r.goal_reached and np.hypot(*(r.plan[0, :2] - (3.0, 0.0))) <= 0.3]
+    turning = [r for r in at_goal if r.command[1] != 0.0]
+    assert turning and all(abs(r.command[0]) <= 0.05 for r in turning)  # it brakes first, then turns in place
+    assert all(r.command[0] <= r.plan[0, 3] + 1e-12 for r in at_goal)  # never speeds up there
+    assert np.hypot(*(run.states[-1][:2] - (3.0, 0.0))) <= 0.3 + 0.05
+    ctl.reset()
+    ctl.set_params(yaw_goal_tolerance=3.2)  # any heading: the goal is reached on arrival
+    run = drive(ctl, (0.0, 0.0, 0.0), (3.0, 0.0, heading), seconds=20.0)
+    assert run.results[-1].goal_reached
+    assert abs(np.angle(np.exp(1j * (run.states[-1][2] - heading)))) > 0.5
+
+
+def test_a_person_within_d_h_at_the_goal_holds_the_turn(ctl: Controller) -> None:
+    """Someone standing 0.4 m from the robot at its goal: no turn, a protective stop with its reason (the paper's
+    C2: no motion with a person within d_h), the goal not reached; once they leave, it turns to the heading."""
+    heading = np.pi / 2
+    x = np.array([0.0, 0.0, 0.0, 0.0])
+    near = np.array([[0.0, -0.4, 0.0, 0.0]])
+    for k in range(20):
+        r = ctl.step(0.1 * k, pose=x[:3], v=x[3], goal=(0.1, 0.0, heading), people=near)
+        assert r.command[1] == 0.0 and not r.goal_reached
+        assert r.stop and r.reason == "human_too_close" and r.outcome_name == "stopped"
+        x = step(RobotModel(), x, r.u, DT)
+    r = ctl.step(2.0, pose=x[:3], v=x[3], goal=(0.1, 0.0, heading), people=np.zeros((0, 4)))
+    assert r.command[1] > 0.0 and not r.goal_reached

@@ -142,6 +142,11 @@ class ClosedLoop(unittest.TestCase):
         with self.log.lock:
             self.log.stops.append((msg.header.stamp.to_sec(), bool(msg.stop), msg.reason_name))
 
+    def last_outcome(self) -> str | None:
+        """The controller's outcome in the node's latest diagnostics (None before any)."""
+        with self.log.lock:
+            return self.log.diags[-1].get("outcome") if self.log.diags else None
+
     def on_diag(self, msg: DiagnosticArray) -> None:
         for st in msg.status:
             if st.hardware_id:
@@ -290,7 +295,10 @@ class ClosedLoop(unittest.TestCase):
                 elif "intrusion" in events and "intruder_left" not in events and t > events["intrusion"] + 1.5:
                     self.intruder = None
                     events["intruder_left"] = t
-                if np.linalg.norm(pos - GOAL_A) < self.goal_tolerance + 0.1 and abs(speed) < 0.05:
+                # reached as a mission executive sees it: at rest there, and the node says so (after its turn
+                # in place to the goal's heading)
+                if (np.linalg.norm(pos - GOAL_A) < self.goal_tolerance + 0.1 and abs(speed) < 0.05
+                        and self.last_outcome() == "goal_reached"):
                     events["goal_a"] = t
                     self.publish_plan(GOAL_B, 300)
                     phase = "to_b"
@@ -309,7 +317,7 @@ class ClosedLoop(unittest.TestCase):
                     people_on = True
                     events["people_on"] = t
                 if ("people_on" in events and np.linalg.norm(pos - GOAL_B) < self.goal_tolerance + 0.1
-                        and abs(speed) < 0.05):
+                        and abs(speed) < 0.05 and self.last_outcome() == "goal_reached"):
                     events["goal_b"] = t
                     phase = "done"
             if phase != "done":
