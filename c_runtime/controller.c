@@ -172,6 +172,16 @@ static int controller_is_loop(const hm_params *p, const hm_output *o)
     return length >= p->loop_min_length && hm_sqrt(dx * dx + dy * dy) < p->loop_ratio * length;
 }
 
+/* A recovery's SQP starts from the guess just simulated into s->x, s->u (whose dynamics' Jacobians it
+ * left in the QP), with no multipliers and the screening radii of a guess that is not a QP's solution. */
+static void controller_start_from_guess(hm_solver *s)
+{
+    s->dyn_fresh = 1;
+    ocp_qp_sol_set_zero(&s->mult);
+    ocp_nlp_screen_reach(s);
+    s->warm = 1; /* the SQP starts from this plan, not from a standstill guess */
+}
+
 /* The start of a sideways recovery: the measured state, the speed the OCP tracks reached within the
  * acceleration bounds, a step to the side (CONTROLLER_NUDGE_*), simulated by the model. */
 static void controller_nudge(hm_controller *c)
@@ -193,10 +203,7 @@ static void controller_nudge(hm_controller *c)
         s->u[n][1] = hm_fmin(hm_fmax(side * w, s->params.omega_bounds[0]), s->params.omega_bounds[1]);
         hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], s->qp.A[n], s->qp.B[n]);
     }
-    s->dyn_fresh = 1;
-    ocp_qp_sol_set_zero(&s->mult);
-    ocp_nlp_screen_reach(s);
-    s->warm = 1; /* the SQP starts from this plan, not from a standstill guess */
+    controller_start_from_guess(s);
 }
 
 /* The bearing of the carrot from a robot at x, in (-pi, pi]. */
@@ -249,10 +256,7 @@ static void controller_turn_start(hm_controller *c)
         s->u[n][1] = hm_fmin(hm_fmax(e / HM_R(HM_DT), p->omega_bounds[0]), p->omega_bounds[1]);
         hm_model_dynamics(s->x[n], s->u[n], s->x[n + 1], s->qp.A[n], s->qp.B[n]);
     }
-    s->dyn_fresh = 1;
-    ocp_qp_sol_set_zero(&s->mult);
-    ocp_nlp_screen_reach(s);
-    s->warm = 1;
+    controller_start_from_guess(s);
 }
 
 /* Where a recovery's SQP starts. */
@@ -291,6 +295,24 @@ static int controller_recover(hm_controller *c, unsigned long long t0, enum cont
         ocp_nlp_sqp_reset(s);
     }
     return ok;
+}
+
+/* 1 when a paced recovery (the goal behind's, the stall's) may run in this period: no plan recovered yet,
+ * no stop, recoveries on, and none of them within the last stall_time (they share the timer). */
+static int controller_may_recover(const hm_controller *c, const hm_controller_input *cin,
+                                  const hm_controller_output *out)
+{
+    return !out->recovered && !c->out.stop && c->params.recovery_iterations > 0 &&
+           (!c->has_recovery || cin->time - c->time_recovery >= c->params.stall_time);
+}
+
+/* controller_recover, its time taken for the pace of controller_may_recover. */
+static int controller_recover_paced(hm_controller *c, const hm_controller_input *cin, unsigned long long t0,
+                                    enum controller_start start, hm_controller_output *out)
+{
+    c->has_recovery = 1;
+    c->time_recovery = cin->time;
+    return controller_recover(c, t0, start, out);
 }
 
 /* Braking to a standstill at the goal, or without one: the protective stop's braking plan, which is
@@ -506,18 +528,10 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
         out->recovered = controller_recover(c, t0, CONTROLLER_START_COLD, out);
     }
     out->stalled = controller_progress(c, cin, &g, c->out.stop, &slow, out);
-    if (!out->recovered && !c->out.stop && c->params.recovery_iterations > 0 && controller_stuck_facing_away(c) &&
-        (!c->has_recovery || cin->time - c->time_recovery >= c->params.stall_time)) {
-        c->has_recovery = 1;
-        c->time_recovery = cin->time;
-        out->recovered = controller_recover(c, t0, CONTROLLER_START_TURN, out);
-    }
-    if ((out->stalled || slow) && !out->recovered && !c->out.stop && c->params.recovery_iterations > 0 &&
-        (!c->has_recovery || cin->time - c->time_recovery >= c->params.stall_time)) {
-        c->has_recovery = 1;
-        c->time_recovery = cin->time;
-        out->recovered = controller_recover(c, t0, CONTROLLER_START_SIDEWAYS, out);
-    }
+    if (controller_may_recover(c, cin, out) && controller_stuck_facing_away(c))
+        out->recovered = controller_recover_paced(c, cin, t0, CONTROLLER_START_TURN, out);
+    if ((out->stalled || slow) && controller_may_recover(c, cin, out))
+        out->recovered = controller_recover_paced(c, cin, t0, CONTROLLER_START_SIDEWAYS, out);
     /* the OCP sees N_h people; the command must keep its distance from every track */
     if (!c->out.stop) {
         const hm_real v = c->out.command[0];
