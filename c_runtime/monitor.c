@@ -84,6 +84,13 @@ static void monitor_separation_reach(hm_real d_h, hm_real t_r, hm_real a_brake, 
     *per_speed = t_r + v_cap / a_brake;
 }
 
+HM_FUNC hm_real monitor_stopping_reach(hm_real d_h, hm_real t_r, hm_real a_brake, hm_real v_cap, hm_real speed_h)
+{
+    hm_real reach0, per_speed;
+    monitor_separation_reach(d_h, t_r, a_brake, v_cap, &reach0, &per_speed);
+    return reach0 + speed_h * per_speed;
+}
+
 /* 1 when the person at (dx, dy) from the robot is ahead of its heading: only they bound its speed. */
 static int monitor_separation_ahead(hm_real cos_t, hm_real sin_t, hm_real dx, hm_real dy)
 {
