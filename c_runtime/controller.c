@@ -97,6 +97,7 @@ HM_FUNC void controller_reset(hm_controller *c)
     c->has_time = 0;
     c->has_recovery = 0;
     c->has_theta = 0;
+    c->has_origin = 0;
     c->best_left = HM_INF;
     c->time_progress = HM_R(0.0);
     c->time_brisk = HM_R(0.0);
@@ -112,6 +113,7 @@ HM_FUNC void controller_init(hm_controller *c, const hm_params *params)
     ocp_nlp_sqp_init(&c->solver, params);
     c->in.n_humans = 0;
     c->in.has_obstacle = 0;
+    c->in.has_refs = 0;
     for (j = 0; j < 2; j++) c->in.obstacle[j] = HM_R(0.0);
     controller_reset(c);
 }
@@ -128,6 +130,13 @@ static void controller_solver_params(hm_controller *c, const hm_controller_goal 
     hm_real v_arrive, arrival;
     *sp = *p;
     if (cap > p->v_bounds[0]) sp->v_bounds[1] = cap;
+    if (p->progress) {
+        /* the per-node goals brake to the goal themselves (controller_references): no taper, no approach */
+        int i;
+        for (i = 0; i < HM_NX; i++) sp->w_goal[i] = p->progress_weights[i];
+        c->in.goal[3] = p->v_ref;
+        return;
+    }
     c->in.goal[3] = hm_fmin(p->v_ref, p->goal_taper * g->left);
     if (p->approach && g->left < p->v_ref * horizon) {
         sp->w_goal[3] = HM_R(0.0);
@@ -147,6 +156,49 @@ static void controller_solver_params(hm_controller *c, const hm_controller_goal 
                   v_arrive / (HM_R(2.0) * p->a_bounds[1]) + p->arrival_margin;
         sp->collision_horizon = hm_fmin(p->collision_horizon, arrival);
     }
+}
+
+/* Where a straight path to a goal pose given alone starts: with the progress objective, where the robot
+ * was when it got that goal (the line must not move with the robot, or walking off sideways would cost
+ * nothing); else the robot itself (the carrot of the paper's objective). */
+static const hm_real *controller_origin(hm_controller *c, const hm_controller_input *cin)
+{
+    const hm_real *end = cin->n_path == 1 ? cin->path[0] : cin->goal;
+    if (!c->params.progress || cin->n_path >= 2) return cin->pose;
+    if (!c->has_origin || c->origin_goal[0] != end[0] || c->origin_goal[1] != end[1]) {
+        c->origin[0] = cin->pose[0];
+        c->origin[1] = cin->pose[1];
+        c->origin_goal[0] = end[0];
+        c->origin_goal[1] = end[1];
+        c->has_origin = 1;
+    }
+    return c->origin;
+}
+
+/* The progress objective's goal per node (params.progress): node n's goal is the point of the path where
+ * a robot that started at its projection now would be at node n's time, going at the speed it could go:
+ * from its measured speed (at least 0), accelerating at the upper bound towards the speed to track
+ * (in->goal[3]: the cruising speed, lowered by speed and separation), and braking at half the lower bound
+ * to arrive at the goal at rest; heading: the path's there; speed: that speed. Motion that does not bring
+ * the robot along its path falls behind these goals and costs; so does standing, once they have moved on.
+ * Sets in->refs and in->has_refs. */
+static void controller_references(hm_controller *c, const hm_controller_input *cin, const hm_controller_goal *g)
+{
+    hm_input *in = &c->in;
+    const hm_params *sp = &c->solver.params;
+    const hm_real dt = HM_R(HM_DT), a_up = sp->a_bounds[1], a_down = HM_R(-0.5) * sp->a_bounds[0];
+    hm_real v = hm_fmin(hm_fmax(cin->v, HM_R(0.0)), in->goal[3]), d = HM_R(0.0);
+    int n;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_real left = hm_fmax(g->length - g->s_proj - d, HM_R(0.0));
+        hm_real *r = in->refs[n];
+        controller_path_at(cin, controller_origin(c, cin), in->x0[2], g->s_proj + d, g, r);
+        r[3] = v;
+        d += v * dt;
+        v = hm_fmin(hm_fmin(in->goal[3], v + a_up * dt),
+                    hm_sqrt(HM_R(2.0) * a_down * hm_fmax(left - v * dt, HM_R(0.0))));
+    }
+    in->has_refs = 1;
 }
 
 /* The length of a planned path. */
@@ -472,7 +524,7 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
     hm_real path[HM_N + 1][2];
     unsigned long long t1;
     int slow = 0;
-    controller_goal(cin, cin->pose, in->x0[2],
+    controller_goal(cin, controller_origin(c, cin), cin->pose, in->x0[2],
                     c->params.lookahead > HM_R(0.0) ? c->params.lookahead : c->params.v_ref * horizon, &g);
     if (!g.has) {
         s->params = c->params;
@@ -506,6 +558,7 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
             in->goal[3] = hm_fmin(in->goal[3], controller_separation_bound(cin, in->x0, dx / len, dy / len, in->goal[3],
                                                                            &c->params));
     }
+    if (c->params.progress) controller_references(c, cin, &g);
     controller_expected_path(s, cin, path);
     controller_select_people(path, cin, &s->params, hm_fmax(hm_fabs(cin->v), s->params.v_bounds[1]), in, out);
     controller_nearest_obstacle(path, cin, c->solver.params.v_bounds[1], in);
@@ -533,6 +586,7 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
     controller_clear_output(out);
     in->n_humans = 0;
     in->has_obstacle = 0;
+    in->has_refs = 0;
     in->x0[0] = cin->pose[0];
     in->x0[1] = cin->pose[1];
     in->x0[2] = cin->pose[2];

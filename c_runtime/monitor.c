@@ -46,6 +46,12 @@ HM_FUNC int monitor_check_input(const hm_input *in, int check_x0)
     int j;
     if (check_x0 && !monitor_state_ok(in->x0)) return 0;
     if (!monitor_state_ok(in->goal)) return 0;
+    if (in->has_refs != 0 && in->has_refs != 1) return 0;
+    if (in->has_refs) {
+        int n;
+        for (n = 0; n <= HM_N; n++)
+            if (!monitor_state_ok(in->refs[n])) return 0;
+    }
     if (in->n_humans < 0 || in->n_humans > HM_NG - 1) return 0;
     if (in->has_obstacle != 0 && in->has_obstacle != 1) return 0;
     if (in->has_obstacle && !monitor_position_ok(in->obstacle)) return 0;

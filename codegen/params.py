@@ -267,6 +267,14 @@ PARAMS: tuple[Param, ...] = (
     Param("lookahead", "controller.lookahead", "real", 0.0,
           "carrot distance along the path (0: v_ref * T, the plan's length at cruising speed)", unit="m",
           valid=Range(0.0, 1e4), controller=True, paper=1e4),
+    Param("progress", "controller.progress", "flag", False,
+          "the progress objective: the OCP tracks a goal per node along the path, each where the robot would be "
+          "at the cruising speed (from its speed, within the acceleration bound, braking to arrive at rest), "
+          "weighted by progress_weights, instead of one carrot with a speed to track in any direction (the "
+          "paper's objective; goal_taper and the approach then apply)", controller=True),
+    Param("progress_weights", "controller.progress_weights", "vector", (20.0, 20.0, 0.0, 1.0),
+          "stage weights on x - g_n with the progress objective (g_n: the node's goal along the path)", size=4,
+          valid=_WEIGHT, controller=True),
     Param("goal_taper", "controller.goal_taper", "real", 0.5,
           "the speed to track is at most goal_taper times the distance left to the goal", unit="1/s",
           valid=Range(0.0, 100.0, lo_open=True), controller=True),
