@@ -32,6 +32,7 @@
  */
 #include "controller.h"
 
+#include "controller_candidates.h"
 #include "controller_goal.h"
 #include "controller_people.h"
 #include "controller_safety.h"
@@ -98,6 +99,7 @@ HM_FUNC void controller_reset(hm_controller *c)
     c->has_recovery = 0;
     c->has_theta = 0;
     c->has_origin = 0;
+    controller_candidates_reset(c);
     c->best_left = HM_INF;
     c->time_progress = HM_R(0.0);
     c->time_brisk = HM_R(0.0);
@@ -111,6 +113,9 @@ HM_FUNC void controller_init(hm_controller *c, const hm_params *params)
     int j;
     c->params = *params;
     ocp_nlp_sqp_init(&c->solver, params);
+#if HM_NCAND > 1
+    for (j = 0; j < HM_NCAND - 1; j++) ocp_nlp_sqp_init(&c->candidates[j], params);
+#endif
     c->in.n_humans = 0;
     c->in.has_obstacle = 0;
     c->in.has_refs = 0;
@@ -451,6 +456,8 @@ static void controller_clear_output(hm_controller_output *out)
     out->stalled = 0;
     out->recovered = 0;
     out->loop_detected = 0;
+    out->candidate = 0;
+    out->candidates_ok = 0;
     out->n_people = 0;
     out->has_obstacle = 0;
     out->distance_to_goal = HM_INF;
@@ -523,7 +530,7 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
     hm_controller_goal g;
     hm_real path[HM_N + 1][2];
     unsigned long long t1;
-    int slow = 0;
+    int slow = 0, chosen;
     controller_goal(cin, controller_origin(c, cin), cin->pose, in->x0[2],
                     c->params.lookahead > HM_R(0.0) ? c->params.lookahead : c->params.v_ref * horizon, &g);
     if (!g.has) {
@@ -564,7 +571,14 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
     controller_nearest_obstacle(path, cin, c->solver.params.v_bounds[1], in);
     t1 = ocp_nlp_now(s);
     ocp_nlp_sqp_rti_step_from(s, in, &c->out, t0);
+    chosen = controller_candidates_step(c, t0, out);
     out->time_solver_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t1);
+    if (chosen != 0) {
+        /* a candidate passes someone: the recoveries are for the main plan's standstills and loops */
+        out->stalled = controller_progress(c, cin, &g, c->out.stop, &slow, out);
+        if (out->stalled) out->outcome = HM_OUTCOME_STALLED;
+        return 0;
+    }
     if (!c->out.stop && c->params.recovery_iterations > 0 && controller_is_loop(&c->params, &c->out)) {
         out->loop_detected = 1;
         out->recovered = controller_recover(c, t0, CONTROLLER_START_COLD, out);

@@ -1,7 +1,7 @@
 /*
  * controller_types.h: the sized type of the navigation controller around the solver, instantiated
  * once per solver like ocp_nlp_types.h (no include guard; the same HM_NS / HM_REAL / HM_N / HM_NG
- * contract). Included by a generated public header after ocp_nlp_types.h: the controller embeds a
+ * contract, and HM_NCAND: the candidate plans, 1 for one). Included by a generated public header after ocp_nlp_types.h: the controller embeds a
  * solver, its input and output, and what it remembers between control periods.
  */
 typedef struct HM_NS(controller) {
@@ -27,4 +27,12 @@ typedef struct HM_NS(controller) {
     int has_origin;
     HM_REAL origin[2];
     HM_REAL origin_goal[2];
+    /* Passing decisions (controller_candidates.h): the other candidate plans, each with its own solver and
+     * output; the decision applied last period: the track id passed (-1: the main plan) and the side. */
+#if HM_NCAND > 1
+    HM_NS(solver) candidates[HM_NCAND - 1];
+    HM_NS(output) candidate_out[HM_NCAND - 1];
+#endif
+    int chosen_id;
+    int chosen_side;
 } HM_NS(controller);

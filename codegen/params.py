@@ -275,6 +275,10 @@ PARAMS: tuple[Param, ...] = (
     Param("progress_weights", "controller.progress_weights", "vector", (20.0, 20.0, 0.0, 1.0),
           "stage weights on x - g_n with the progress objective (g_n: the node's goal along the path)", size=4,
           valid=_WEIGHT, controller=True),
+    Param("candidate_hysteresis", "controller.candidate_hysteresis", "real", 0.1,
+          "with several candidate plans: another plan replaces the one applied last period only when it costs "
+          "less by this fraction of its cost (the robot does not switch sides back and forth)",
+          valid=Range(0.0, 1.0, hi_open=True), controller=True),
     Param("goal_taper", "controller.goal_taper", "real", 0.5,
           "the speed to track is at most goal_taper times the distance left to the goal", unit="1/s",
           valid=Range(0.0, 100.0, lo_open=True), controller=True),

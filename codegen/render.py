@@ -53,6 +53,7 @@ RUNTIME_SOURCES = (
     "controller_people.c",
     "controller_tracks.c",
     "controller_safety.c",
+    "controller_candidates.c",
     "controller.c",
 )
 
@@ -177,6 +178,7 @@ def template_context(spec: Spec, functions: list[EmittedFunction], real: str) ->
         "NT": int(spec.controller.max_tracks),
         "NP": int(spec.controller.max_path_points),
         "NK": int(spec.controller.max_obstacle_points),
+        "NC": int(spec.controller.candidates),
         "runtime_sources": RUNTIME_SOURCES,
         "dt": c_float(spec.dt),
         "statuses": status_tables(),

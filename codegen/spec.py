@@ -272,11 +272,15 @@ class Controller:
     max_path_points: int = integer(256, "P: waypoints of the reference path (a fixed size)", ge=2, le=100_000)
     max_obstacle_points: int = integer(256, "K: obstacle points (a scan's or a costmap's) per step (a fixed size)",
                                        ge=1, le=100_000)
+    candidates: int = integer(1, "candidate plans per period (a fixed size): the main plan and ones that pass the "
+                                 "nearest people on either side, the cheapest safe one applied (1: one plan)",
+                              ge=1, le=8)
     v_ref: float = param("controller.v_ref")
     speed_limit: float = param("controller.speed_limit")
     lookahead: float = param("controller.lookahead")
     progress: bool = param("controller.progress")
     progress_weights: tuple[float, ...] = param("controller.progress_weights")
+    candidate_hysteresis: float = param("controller.candidate_hysteresis")
     goal_taper: float = param("controller.goal_taper")
     goal_tolerance: float = param("controller.goal_tolerance")
     yaw_goal_tolerance: float = param("controller.yaw_goal_tolerance")

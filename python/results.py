@@ -140,6 +140,8 @@ class ControllerResult:
     ocp_goal            the goal the OCP tracked [x, y, theta, v_ref] (the carrot)
     people_ids, people_index, predictions (N + 1, n_people, 2): the tracks the OCP used
     n_tracks_dropped    people given beyond max_tracks and left out (the farthest)
+    candidate           the plan applied (0: the main plan; k: the k-th candidate passing someone), and
+                        candidates_ok, how many plans passed the monitors
     obstacle            the obstacle point the OCP kept d_s from, or None
     distance_to_goal [m], time_without_progress [s], min_human_distance [m]
     time_ms, time_solver_ms, time_recovery_ms
@@ -200,6 +202,8 @@ class ControllerResult:
     stalled = _field("stalled", bool)
     recovered = _field("recovered", bool)
     n_tracks_dropped = _field("n_tracks_dropped", int)
+    candidate = _field("candidate", int)
+    candidates_ok = _field("candidates_ok", int)
     loop_detected = _field("loop_detected", bool)
     status = _field("status", int)
     qp_status = _field("qp_status", int)
