@@ -550,9 +550,11 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
     in->goal[2] = g.carrot[2];
     controller_solver_params(c, &g);
     if (g.to_final <= c->params.goal_tolerance) {
+        /* reached: within the tolerance, the heading met, and at rest (nav2's stopped goal checker); until the
+         * robot stands, it is braking towards its goal */
         const enum controller_at_goal_state state = controller_at_goal(c, cin, g.final[2]);
-        if (state == CONTROLLER_GOAL_DONE) out->outcome = HM_OUTCOME_GOAL_REACHED;
-        out->goal_reached = state == CONTROLLER_GOAL_DONE;
+        out->goal_reached = state == CONTROLLER_GOAL_DONE && hm_fabs(cin->v) <= CONTROLLER_AT_REST;
+        if (out->goal_reached) out->outcome = HM_OUTCOME_GOAL_REACHED;
         controller_progress(c, cin, &g, 1, &slow, out);
         return 1;
     }

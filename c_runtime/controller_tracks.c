@@ -9,12 +9,16 @@
 
 #include "monitor.h"
 
-/* Squared distance of a track from the pose; -1 (nearest of all) for a position that is not finite. */
+/* Squared distance of a track from the pose; -1 (nearest of all) for a track with any entry that is not
+ * finite (a far position with a NaN velocity too: kept, it stops the robot as an invalid input). */
 static hm_real controller_track_rank(const hm_real *pose, const hm_real *t)
 {
     const hm_real dx = t[0] - pose[0], dy = t[1] - pose[1];
     const hm_real d2 = dx * dx + dy * dy;
-    return monitor_finite(t[0]) && monitor_finite(t[1]) && monitor_finite(d2) ? d2 : HM_R(-1.0);
+    return monitor_finite(t[0]) && monitor_finite(t[1]) && monitor_finite(t[2]) && monitor_finite(t[3]) &&
+                   monitor_finite(d2)
+               ? d2
+               : HM_R(-1.0);
 }
 
 static void controller_put_track(hm_controller_input *in, int slot, int i, const hm_real (*tracks)[4], const int *ids,

@@ -343,7 +343,8 @@ def test_a_goal_behind_the_robot_within_the_approach_is_reached(ctl: Controller,
     assert run.results[-1].goal_reached
     assert any(r.recovered for r in run.results)
     assert run.path_length() < distance + 1.5  # the way there: a turn, then straight on
-    assert len(run.results) * DT < 3.0 + 1.5 * distance
+    # reached at rest (the goal checker's standstill): a period more than reached on entering the tolerance
+    assert len(run.results) * DT < 3.1 + 1.5 * distance
 
 
 def test_a_robot_that_cannot_leave_its_standstill_says_it_is_stalled(ctl: Controller) -> None:
