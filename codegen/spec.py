@@ -15,7 +15,9 @@ import hashlib
 import io
 import json
 import math
+import os
 import re
+import stat
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -497,21 +499,83 @@ _UniqueKeyLoader.add_constructor(
 )
 
 
-# A spec is a few dozen lines: anything much larger is a mistake (or an attack on the loader).
+# A spec is a few dozen lines, a few levels deep: anything much larger or deeper is a mistake (or an
+# attack on the loader: PyYAML composes nested collections recursively, 400 levels in 1 KB raised
+# RecursionError).
 MAX_SPEC_BYTES = 64 * 1024
+MAX_SPEC_DEPTH = 16
+
+
+def _line_text(text: str, line: int) -> str:
+    """Line ``line`` (0-based) of text, stripped and cut short, for a message."""
+    lines = text.splitlines()
+    got = lines[line].strip() if 0 <= line < len(lines) else ""
+    return got if len(got) <= 60 else got[:57] + "..."
+
+
+def _yaml_problem(err: yaml.MarkedYAMLError, text: str) -> str:
+    """PyYAML's error in our words, naming the line of the mistake: PyYAML marks where it noticed it,
+    for a key without ':' or an unclosed bracket or quote the line after; its context mark is the line
+    where the unfinished thing began."""
+    problem = err.problem or "a syntax error"
+    context = err.context or ""
+    pm, cm = err.problem_mark, err.context_mark
+    at = pm.line if pm is not None else 0
+    began = cm.line if cm is not None else at
+    if "simple key" in context:
+        return (f"line {began + 1}: {_line_text(text, began)!r} is a key without ':' (write 'key: value'); "
+                f"not valid YAML")
+    if "flow" in context:
+        return (f"line {began + 1}: a '[' or '{{' opened on this line is not closed ({problem} on line {at + 1}); "
+                "not valid YAML")
+    if "quoted scalar" in context:
+        return f"line {began + 1}: a quoted string opened on this line is not closed; not valid YAML"
+    if "'\\t'" in problem:
+        return f"line {at + 1}: a tab character: indent with spaces; not valid YAML"
+    if "mapping values are not allowed" in problem:
+        return (f"line {at + 1}: {_line_text(text, at)!r} has a ':' where YAML cannot start a key: quote a value "
+                "that holds ': ', or indent the key under its section; not valid YAML")
+    if "block end" in problem:
+        return (f"line {at + 1}: {_line_text(text, at)!r} does not fit the indentation or the lines above "
+                f"({problem}); not valid YAML")
+    where = f" ({context} from line {began + 1})" if context and began != at else ""
+    return f"line {at + 1}: {problem}{where}; not valid YAML"
+
+
+def _check_depth(text: str, source: str) -> None:
+    """Refuse collections nested deeper than MAX_SPEC_DEPTH by scanning the parser's events, which
+    PyYAML produces without recursion, before anything is composed."""
+    depth = 0
+    try:
+        for event in yaml.parse(io.StringIO(text), Loader=_UniqueKeyLoader):
+            if isinstance(event, yaml.CollectionStartEvent):
+                depth += 1
+                if depth > MAX_SPEC_DEPTH:
+                    line = event.start_mark.line + 1 if event.start_mark is not None else 0
+                    raise SpecError([f"line {line}: lists and maps nested more than {MAX_SPEC_DEPTH} deep: a spec "
+                                     "is a few levels deep (see humanmpc-gen keys)"], source)
+            elif isinstance(event, yaml.CollectionEndEvent):
+                depth -= 1
+    except yaml.MarkedYAMLError as err:
+        raise SpecError([_yaml_problem(err, text)], source) from None
+    except yaml.YAMLError as err:
+        raise SpecError([f"not valid YAML: {err}"], source) from None
 
 
 def _parse_yaml(text: str, source: str) -> Any:
-    """The YAML document in text: safe loader, duplicate keys and aliases refused, size bounded,
-    errors naming the source."""
+    """The YAML document in text: safe loader, duplicate keys and aliases refused, size and nesting
+    bounded, errors naming the source and the line."""
     if len(text.encode("utf-8", errors="replace")) > MAX_SPEC_BYTES:
         raise SpecError([f"the spec is {len(text):,} characters long: at most {MAX_SPEC_BYTES:,} bytes"], source)
+    _check_depth(text, source)
     stream = io.StringIO(text)
     stream.name = source  # PyYAML names this in its error marks
     try:
         return yaml.load(stream, Loader=_UniqueKeyLoader)
     except SpecError as err:
         raise SpecError(err.problems, source) from None
+    except yaml.MarkedYAMLError as err:
+        raise SpecError([_yaml_problem(err, text)], source) from None
     except yaml.YAMLError as err:
         raise SpecError([f"not valid YAML: {err}"], source) from None
 
@@ -521,19 +585,44 @@ def parse_spec_text(text: str, source: str = "spec") -> Spec:
     return resolve_spec(_parse_yaml(text, source), source)
 
 
+_FILE_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+               (stat.S_ISFIFO, "a pipe (FIFO)"), (stat.S_ISSOCK, "a socket"))
+
+
+def read_spec_file(path: Path) -> str:
+    """The text of the spec file at path, read with bounds whatever the path is: a regular file of at most
+    MAX_SPEC_BYTES (at most that many bytes are read, so a file that grows or lies about its size, such as
+    one under /proc, cannot exhaust memory); a device, pipe, socket or folder is refused without reading
+    from it (opened non-blocking, so a FIFO without a writer cannot hang the command)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+    except OSError as err:
+        raise SpecError([f"cannot read {path}: {err.strerror}"], str(path)) from None
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            kind = next((what for test, what in _FILE_KINDS if test(mode)), "not a regular file")
+            raise SpecError([f"{path} is {kind}, not a spec file: give a YAML file"], str(path))
+        with os.fdopen(os.dup(fd), "rb") as f:
+            data = f.read(MAX_SPEC_BYTES + 1)
+    except OSError as err:
+        raise SpecError([f"cannot read {path}: {err.strerror}"], str(path)) from None
+    finally:
+        os.close(fd)
+    if len(data) > MAX_SPEC_BYTES:
+        raise SpecError([f"{path} is larger than {MAX_SPEC_BYTES:,} bytes, the most a spec may be"], str(path))
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise SpecError([f"{path} is not UTF-8 text: {err.reason} at byte {err.start}"], str(path)) from None
+
+
 def load_spec(path: str | Path | None) -> Spec:
     """The spec in the YAML file at ``path``, or the built-in default spec when ``path`` is None."""
     if path is None:
         return Spec()
     p = Path(path)
-    try:
-        if p.stat().st_size > MAX_SPEC_BYTES:
-            raise SpecError([f"{p} is {p.stat().st_size:,} bytes: a spec is at most {MAX_SPEC_BYTES:,}"], str(p))
-        text = p.read_text(encoding="utf-8")
-    except OSError as err:
-        raise SpecError([f"cannot read {p}: {err.strerror}"], str(p)) from None
-    except UnicodeDecodeError as err:
-        raise SpecError([f"{p} is not UTF-8 text: {err.reason} at byte {err.start}"], str(p)) from None
+    text = read_spec_file(p)
     data = _parse_yaml(text, str(p))
     if data is None:
         raise SpecError([f"{p} holds no keys: write at least one (e.g. name: mysolver), or give no file to use "
