@@ -25,6 +25,7 @@ from typing import Any, cast
 
 import yaml
 
+from .names import clash, reserved_prefix
 from .params import BY_KEY, Param, paper_values
 
 
@@ -56,13 +57,17 @@ C_KEYWORDS = frozenset(
 )
 RESERVED_NAMES = frozenset({"hm", "casadi", "humanmpc", "main", "errno", "assert"})
 # The package writes <name>.h beside the sources that include the system's headers: a name that is
-# a standard C or common POSIX header's would shadow it (a spec named "time" silently replaced
-# <time.h>, and with it the deadline monitor's clock).
+# a standard C or POSIX header's would shadow it (a spec named "time" silently replaced <time.h>, and
+# with it the deadline monitor's clock). C99/C11/C23 headers, POSIX's, and common others.
 SYSTEM_HEADER_NAMES = frozenset({
     "assert", "complex", "ctype", "errno", "fenv", "float", "inttypes", "iso646", "limits", "locale", "math",
-    "setjmp", "signal", "stdalign", "stdarg", "stdatomic", "stdbool", "stddef", "stdint", "stdio", "stdlib",
-    "stdnoreturn", "string", "tgmath", "threads", "time", "uchar", "wchar", "wctype", "unistd", "pthread",
-    "sched", "fcntl", "strings", "alloca", "malloc", "features", "endian", "cffi", "casadi",
+    "setjmp", "signal", "stdalign", "stdarg", "stdatomic", "stdbit", "stdbool", "stdckdint", "stddef", "stdint",
+    "stdio", "stdlib", "stdnoreturn", "string", "tgmath", "threads", "time", "uchar", "wchar", "wctype",
+    "aio", "arpa", "cpio", "dirent", "dlfcn", "fcntl", "fmtmsg", "fnmatch", "ftw", "glob", "grp", "iconv",
+    "langinfo", "libgen", "monetary", "mqueue", "ndbm", "net", "netdb", "netinet", "nl_types", "poll",
+    "pthread", "pwd", "regex", "sched", "search", "semaphore", "spawn", "strings", "stropts", "sys", "syslog",
+    "tar", "termios", "trace", "ulimit", "unistd", "utime", "utmpx", "wordexp", "alloca", "malloc", "features",
+    "endian", "memory", "cffi", "casadi", "printf",
 })
 # Matched with fullmatch: "$" alone also matches before a trailing newline.
 IDENT_RE = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
@@ -152,6 +157,17 @@ class Rule:
         if value.lower() in SYSTEM_HEADER_NAMES:
             return None, [f"{path}: {value!r} is reserved: the package's {value}.h would shadow the system header "
                           f"<{value.lower()}.h>: choose another name"]
+        if value != value.lower():
+            return None, [f"{path}: {value!r} has capital letters: the name becomes file names (one file on a "
+                          f"case-insensitive file system) and upper-case macros ({value.upper()}_N), the same for "
+                          f"{value.lower()!r}: use lower case"]
+        why = reserved_prefix(value)
+        if why is not None:
+            return None, [f"{path}: {value!r} is reserved: its external symbols ({value}_solver_step, ...) would "
+                          f"begin like {why}: choose another name"]
+        found = clash(value)
+        if found is not None:
+            return None, [f"{path}: {value!r} could clash with another package: {found.explain()}"]
         return value, []
 
 
