@@ -29,8 +29,16 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     return 0
 
 
+# The system's Python, which has ROS's modules: catkin otherwise takes the first python3 on PATH, and a
+# virtual environment's stops the build with "No module named 'catkin_pkg'".
+CATKIN_MAKE = "catkin_make -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3"
+
+
 def _cmd_ros(args: argparse.Namespace) -> int:
-    print(write_ros(args.dir, args.output, force=args.force))
+    out = write_ros(args.dir, args.output, force=args.force)
+    print(out)
+    print(f"next: mkdir -p ~/ws/src && cp -r {out} ~/ws/src/ && cd ~/ws && {CATKIN_MAKE}  (docs/ros.md)",
+          file=sys.stderr)
     return 0
 
 

@@ -41,3 +41,19 @@ def test_the_missing_pedestrian_data_message_names_each_place_once_what_the_data
     assert message.count(str(sibling)) == 1, message
     assert f"{PEDESTRIANS_ENV} is not set" in message and f"set {PEDESTRIANS_ENV} to the folder" in message
     assert "ETH/UCY" in message and "biwi_eth.txt" in message and "BIWI Walking Pedestrians" in message
+
+
+def _documented_catkin_make() -> str:
+    lines = (REPO_ROOT / "docs" / "ros.md").read_text().splitlines()
+    command = next(ln for ln in lines if "catkin_make" in ln and ln.strip().startswith("cd ~/ws"))
+    return command.split("#", 1)[0]  # the command, not a comment after it
+
+
+def test_the_documented_and_printed_catkin_make_name_the_system_python(
+        paper_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """With another python3 first on PATH (a venv, pyenv), catkin_make failed with "No module named
+    'catkin_pkg'"; docs/ros.md had the fix only as a trailing comment, and `humanmpc-gen ros` printed none."""
+    assert "-DPYTHON_EXECUTABLE=/usr/bin/python3" in _documented_catkin_make()
+    assert cli.main(["ros", str(paper_dir), "-o", str(tmp_path / "ros_src")]) == 0
+    err = capsys.readouterr().err
+    assert "catkin_make" in err and "-DPYTHON_EXECUTABLE=/usr/bin/python3" in err
