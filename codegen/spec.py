@@ -548,6 +548,8 @@ def _yaml_problem(err: yaml.MarkedYAMLError, text: str) -> str:
         return f"line {began + 1}: a quoted string opened on this line is not closed; not valid YAML"
     if "'\\t'" in problem:
         return f"line {at + 1}: a tab character: indent with spaces; not valid YAML"
+    if "another document" in problem:
+        return f"line {at + 1}: a second YAML document ('---'): a spec is one document; not valid YAML"
     if "mapping values are not allowed" in problem:
         return (f"line {at + 1}: {_line_text(text, at)!r} has a ':' where YAML cannot start a key: quote a value "
                 "that holds ': ', or indent the key under its section; not valid YAML")
@@ -556,6 +558,23 @@ def _yaml_problem(err: yaml.MarkedYAMLError, text: str) -> str:
                 f"({problem}); not valid YAML")
     where = f" ({context} from line {began + 1})" if context and began != at else ""
     return f"line {at + 1}: {problem}{where}; not valid YAML"
+
+
+def _reader_problem(err: yaml.reader.ReaderError, text: str) -> str:
+    """A character YAML does not accept (a control character), by line and column."""
+    line = text.count("\n", 0, err.position) + 1
+    column = err.position - (text.rfind("\n", 0, err.position) + 1) + 1
+    char = err.character if isinstance(err.character, int) else ord(err.character)
+    return (f"line {line}, column {column}: the character U+{char:04X} is not allowed in YAML "
+            "(a control character): remove it; not valid YAML")
+
+
+def _yaml_error(err: yaml.YAMLError, text: str) -> str:
+    if isinstance(err, yaml.MarkedYAMLError):
+        return _yaml_problem(err, text)
+    if isinstance(err, yaml.reader.ReaderError):
+        return _reader_problem(err, text)
+    return f"not valid YAML: {err}"
 
 
 def _check_depth(text: str, source: str) -> None:
@@ -572,10 +591,8 @@ def _check_depth(text: str, source: str) -> None:
                                      "is a few levels deep (see humanmpc-gen keys)"], source)
             elif isinstance(event, yaml.CollectionEndEvent):
                 depth -= 1
-    except yaml.MarkedYAMLError as err:
-        raise SpecError([_yaml_problem(err, text)], source) from None
     except yaml.YAMLError as err:
-        raise SpecError([f"not valid YAML: {err}"], source) from None
+        raise SpecError([_yaml_error(err, text)], source) from None
 
 
 def _parse_yaml(text: str, source: str) -> Any:
@@ -590,10 +607,8 @@ def _parse_yaml(text: str, source: str) -> Any:
         return yaml.load(stream, Loader=_UniqueKeyLoader)
     except SpecError as err:
         raise SpecError(err.problems, source) from None
-    except yaml.MarkedYAMLError as err:
-        raise SpecError([_yaml_problem(err, text)], source) from None
     except yaml.YAMLError as err:
-        raise SpecError([f"not valid YAML: {err}"], source) from None
+        raise SpecError([_yaml_error(err, text)], source) from None
 
 
 def parse_spec_text(text: str, source: str = "spec") -> Spec:

@@ -227,6 +227,8 @@ def test_a_number_too_large_for_a_double_is_an_error_not_a_traceback(tmp_path: P
     ("horizon:\n\tN: 50\n", 2, "tab character: indent with spaces"),
     ("horizon:\n    N: 5\n  T: 3\n", 3, "'T: 3' does not fit the indentation"),
     ("name: a: b\n", 1, "quote a value"),
+    ("name: a\nx: \x01\n", 2, "U+0001 is not allowed in YAML"),
+    ("name: a\n---\nname: b\n", 2, "a spec is one document"),
 ])
 def test_a_yaml_syntax_error_names_the_file_and_the_line_of_the_mistake(tmp_path: Path, text: str, line: int,
                                                                         words: str) -> None:
@@ -237,7 +239,7 @@ def test_a_yaml_syntax_error_names_the_file_and_the_line_of_the_mistake(tmp_path
     with pytest.raises(SpecError) as info:
         load_spec(f)
     assert str(info.value).startswith(f"invalid {f}:")
-    assert info.value.problems[0].startswith(f"line {line}: "), info.value.problems
+    assert info.value.problems[0].startswith((f"line {line}: ", f"line {line}, ")), info.value.problems
     assert words in info.value.problems[0]
     assert "while scanning" not in str(info.value) and "while parsing" not in str(info.value)
 
