@@ -8,9 +8,11 @@ two suffixes s, t: then ``b == a + w`` and ``s == w + t``. So a name is refused 
 that pass have disjoint file names, symbols, macros and targets. Names are lower case, so no two differ
 only in case (one file on a case-insensitive file system, the same upper-case macros).
 
-tests/test_names.py checks that the table covers everything a generated package defines (its files,
-``nm``'s external symbols, the identifiers its headers declare, its CMake and ROS targets) and proves
-the rule over the table.
+The table: what the templates print after the name (scanned, so a new function joins by itself), the
+runtime's HM_NS types, the status constants, CasADi's names, and the lists below (files the generator
+names itself, targets). tests/test_names.py checks that the table covers everything a generated
+package defines (its files, ``nm``'s external symbols, the identifiers its headers declare, its CMake
+and ROS targets) and proves the rule over the table.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import re
 from dataclasses import dataclass
 from functools import cache
 
-from .resources import runtime_files
+from .resources import runtime_files, templates_dir
 from .status import status_tables
 
 # The model functions CasADi generates as <name>_model_<function> (codegen/ocp.py), and what CasADi's
@@ -63,12 +65,28 @@ def runtime_type_suffixes() -> tuple[str, ...]:
     return tuple(sorted(f"_{t.lower()}" for t in found))
 
 
+# A name the templates print after the solver's name (or the ROS package's, <name>_ros): {{ name }}_step ...
+_TEMPLATE_NAME = re.compile(r"\{\{\s*(name|NAME|package)\s*\}\}([A-Za-z0-9_.]*)")
+
+
+@cache
+def template_suffixes() -> tuple[str, ...]:
+    """Every suffix the templates print literally after the name: a function, type, macro or file added
+    to a template joins the table by itself."""
+    found = set()
+    for path in templates_dir().rglob("*.j2"):
+        for kind, tail in _TEMPLATE_NAME.findall(path.read_text()):
+            tail = tail.rstrip(".")  # the end of a sentence in a comment
+            found.add(("_ros" if kind == "package" else "") + tail.lower())
+    return tuple(sorted(found))
+
+
 @cache
 def suffixes() -> frozenset[str]:
     """The whole table, in lower case: the lists above, CasADi's per-function names, and the status
     constants <NAME>_<ID> of runtime/hm_status.h (<NAME>_STOP_DEADLINE, <NAME>_OUTCOME_STALLED, ...)."""
     codes = tuple(f"_{code.id.lower()}" for rows in status_tables().values() for code in rows)
-    return frozenset(_FILES + _TARGETS + _API + _MACROS + codes + runtime_type_suffixes()
+    return frozenset(_FILES + _TARGETS + _API + _MACROS + codes + runtime_type_suffixes() + template_suffixes()
                      + tuple(f"_model_{f}{c}" for f in MODEL_FUNCTIONS for c in CASADI_FUNCTION_SUFFIXES))
 
 # Identifiers C reserves for the library with external linkage, whatever headers a program includes
