@@ -124,7 +124,8 @@ def build(solver_dir: str | Path, *, cc: str | None = None, cflags: str | None =
         raise BuildError(f"C compiler {compiler!r} was not found on PATH (set CC or install gcc)")
     want = wants_native(env) if native is None else native
     if want and not native_supported(compiler):
-        raise BuildError(f"C compiler {compiler!r} does not take {NATIVE_FLAGS}: build without --native")
+        raise BuildError(f"C compiler {compiler!r} does not take {NATIVE_FLAGS}: build without --native "
+                         f"(and without {NATIVE_ENV}=1)")
     env["CFLAGS"] = env.get("CFLAGS") or PORTABLE_CFLAGS
     env["NATIVE"] = "1" if want else "0"
     shown = f"{env['CFLAGS']} {NATIVE_FLAGS}" if want else env["CFLAGS"]
