@@ -80,9 +80,11 @@ test: venv-test
 demo: venv
 	$(GEN) demo --out out/demo
 
+# Timed on libraries tuned to this machine's CPU (HUMANMPC_NATIVE=1: -march=native, the same results bit
+# for bit as the portable default), as docs/benchmarks.md states.
 bench: venv
-	$(GEN) bench --out out/bench
-	$(GEN) bench --compare --compare-out out/compare
+	HUMANMPC_NATIVE=1 $(GEN) bench --out out/bench
+	HUMANMPC_NATIVE=1 $(GEN) bench --compare --compare-out out/compare
 
 # The default spec's solver and navigation controller as firmware: double on a Cortex-M7, float on a
 # Cortex-M4F, each replaying a recorded crowd (the solver) and a recorded closed loop (the controller)

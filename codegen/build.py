@@ -9,7 +9,7 @@ import shutil
 import struct
 import subprocess
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 from .generate import MANIFEST
@@ -21,9 +21,19 @@ class BuildError(RuntimeError):
 
 def read_manifest(solver_dir: Path) -> dict[str, object]:
     path = solver_dir / MANIFEST
+    if not solver_dir.exists():
+        raise BuildError(f"{solver_dir} does not exist: give the folder `humanmpc-gen generate` wrote "
+                         "(by default generated/<name>)")
+    if not solver_dir.is_dir():
+        raise BuildError(f"{solver_dir} is a file, not a folder: give the folder `humanmpc-gen generate` wrote")
     if not path.is_file():
         raise BuildError(f"{solver_dir} is not a generated humanmpc solver: {MANIFEST} is missing")
-    data: dict[str, object] = json.loads(path.read_text())
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError) as err:
+        raise BuildError(f"{path} cannot be read as a manifest ({err}): generate the package again") from None
+    if not isinstance(data, dict):
+        raise BuildError(f"{path} is not a manifest (not a JSON object): generate the package again")
     return data
 
 
@@ -42,40 +52,62 @@ def is_stale(solver_dir: Path) -> bool:
     return lib.stat().st_mtime < newest
 
 
-# Flags of a library built for this machine (Python bindings, benchmarks): tuned to the host's CPU
-# (SIMD of the fixed-size kernels; measured 25 % less time per RTI step than -O2 alone) with IEEE
-# arithmetic kept (no fused multiply-add contraction, so results equal those of a plain -O2 build
-# and of the firmware). A generated folder built by its own Makefile or CMakeLists uses the
-# portable -O2 unless told otherwise.
-HOST_CFLAGS = "-O2 -march=native -funroll-loops -ffp-contract=off"
-PORTABLE_CFLAGS = "-O2"
-_host_flags_ok: dict[str, bool] = {}
+# One flag policy for `humanmpc-gen build`, the package's Makefile and its CMakeLists: portable by
+# default (the library runs on any CPU of the architecture: it may be copied to the robot), tuned to
+# this machine's CPU on request (`build --native`, `make NATIVE=1`, `cmake -DHUMANMPC_NATIVE=ON`,
+# $HUMANMPC_NATIVE=1 for the Python callers: SIMD of the fixed-size kernels, measured 25 % less time per
+# RTI step). Both keep IEEE arithmetic (no fused multiply-add contraction), so a native build computes
+# the same bits as a portable one and as the firmware (tested).
+PORTABLE_CFLAGS = "-O2 -ffp-contract=off"
+NATIVE_FLAGS = "-march=native -funroll-loops"  # added on request, after the portable ones
+NATIVE_CFLAGS = f"{PORTABLE_CFLAGS} {NATIVE_FLAGS}"
+HOST_CFLAGS = NATIVE_CFLAGS  # the former name
+NATIVE_ENV = "HUMANMPC_NATIVE"
+# What the package's Makefile writes beside the library: the compile command its objects were built with.
+FLAGS_FILE = "cflags.txt"
+_native_ok: dict[str, bool] = {}
+
+
+def native_supported(compiler: str) -> bool:
+    """Whether the compiler accepts NATIVE_FLAGS (checked once per compiler)."""
+    if compiler not in _native_ok:
+        try:
+            proc = subprocess.run([*compiler.split(), *NATIVE_CFLAGS.split(), "-x", "c", "-c", "-o", os.devnull, "-"],
+                                  input="int x;\n", capture_output=True, text=True, timeout=60, check=False)
+            _native_ok[compiler] = proc.returncode == 0
+        except (OSError, subprocess.TimeoutExpired):
+            _native_ok[compiler] = False
+    return _native_ok[compiler]
 
 
 def host_cflags(compiler: str) -> str:
-    """HOST_CFLAGS if the compiler accepts them (checked once per compiler), else PORTABLE_CFLAGS."""
-    if compiler not in _host_flags_ok:
-        try:
-            proc = subprocess.run([*compiler.split(), *HOST_CFLAGS.split(), "-x", "c", "-c", "-o", os.devnull, "-"],
-                                  input="int x;\n", capture_output=True, text=True, timeout=60, check=False)
-            _host_flags_ok[compiler] = proc.returncode == 0
-        except (OSError, subprocess.TimeoutExpired):
-            _host_flags_ok[compiler] = False
-    return HOST_CFLAGS if _host_flags_ok[compiler] else PORTABLE_CFLAGS
+    """NATIVE_CFLAGS if the compiler accepts them, else PORTABLE_CFLAGS."""
+    return NATIVE_CFLAGS if native_supported(compiler) else PORTABLE_CFLAGS
 
 
-def compiler_and_flags(env: dict[str, str] | None = None) -> tuple[str, str]:
-    """The C compiler and flags a build uses: $CC (default cc) and $CFLAGS, else ``host_cflags``."""
+def wants_native(env: Mapping[str, str] | None = None) -> bool:
+    """$HUMANMPC_NATIVE is 1 (or yes, true, on)."""
+    e = os.environ if env is None else env
+    return e.get(NATIVE_ENV, "").strip().lower() in ("1", "yes", "true", "on")
+
+
+def compiler_and_flags(env: Mapping[str, str] | None = None, native: bool | None = None) -> tuple[str, str]:
+    """The C compiler and flags a build uses: $CC (default cc); $CFLAGS or PORTABLE_CFLAGS, followed by
+    NATIVE_FLAGS when native (default: $HUMANMPC_NATIVE) and the compiler takes them."""
     e = os.environ if env is None else env
     compiler = e.get("CC", "cc")
-    return compiler, e.get("CFLAGS") or host_cflags(compiler)
+    flags = e.get("CFLAGS") or PORTABLE_CFLAGS
+    if (wants_native(e) if native is None else native) and native_supported(compiler):
+        flags = f"{flags} {NATIVE_FLAGS}"
+    return compiler, flags
 
 
-def build(solver_dir: str | Path, *, cc: str | None = None, cflags: str | None = None,
+def build(solver_dir: str | Path, *, cc: str | None = None, cflags: str | None = None, native: bool | None = None,
           log: Callable[[str], None] | None = None) -> Path:
     """Run the package's Makefile; return the path of the shared library.
 
-    Compiler flags: ``cflags``, else $CFLAGS, else ``host_cflags`` of the compiler."""
+    Compiler flags: ``cflags``, else $CFLAGS, else PORTABLE_CFLAGS; with ``native`` (default:
+    $HUMANMPC_NATIVE) followed by NATIVE_FLAGS. The Makefile rebuilds when the flags change."""
     d = Path(solver_dir).resolve()
     read_manifest(d)
     say = log or (lambda msg: print(msg, file=sys.stderr))
@@ -90,8 +122,15 @@ def build(solver_dir: str | Path, *, cc: str | None = None, cflags: str | None =
     compiler = env.get("CC", "cc")
     if shutil.which(compiler.split()[0]) is None:
         raise BuildError(f"C compiler {compiler!r} was not found on PATH (set CC or install gcc)")
-    compiler, env["CFLAGS"] = compiler_and_flags(env)
-    say(f"[humanmpc] building {d.name} with {compiler} ({env['CFLAGS']})")
+    want = wants_native(env) if native is None else native
+    if want and not native_supported(compiler):
+        raise BuildError(f"C compiler {compiler!r} does not take {NATIVE_FLAGS}: build without --native "
+                         f"(and without {NATIVE_ENV}=1)")
+    env["CFLAGS"] = env.get("CFLAGS") or PORTABLE_CFLAGS
+    env["NATIVE"] = "1" if want else "0"
+    shown = f"{env['CFLAGS']} {NATIVE_FLAGS}" if want else env["CFLAGS"]
+    kind = "tuned to this machine's CPU" if want else "portable"
+    say(f"[humanmpc] building {d.name} with {compiler} ({shown}; {kind})")
     proc = subprocess.run([make, "-C", str(d), "--no-print-directory", "all"], env=env,
                           capture_output=True, text=True, check=False)
     if proc.returncode != 0:
@@ -101,6 +140,16 @@ def build(solver_dir: str | Path, *, cc: str | None = None, cflags: str | None =
     record_library(lib)
     say(f"[humanmpc] built {lib}")
     return lib
+
+
+def built_flags(solver_dir: Path) -> str | None:
+    """The compile command of the package's library as its Makefile recorded it (build/cflags.txt), or None
+    (not built, or built by a Makefile of an older humanmpc)."""
+    path = library_path(solver_dir).parent / FLAGS_FILE
+    try:
+        return path.read_text().strip() or None
+    except OSError:
+        return None
 
 
 # -- the library's integrity, checked by humanmpc.load before dlopen ---------------------------------------

@@ -9,6 +9,7 @@ text CasADi wrote and checked by the compile and nm tests.
 
 from __future__ import annotations
 
+import errno
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -119,6 +120,24 @@ def use_portable_math(source: str) -> str:
     return renamed.replace(_MATH_INCLUDE, _MATH_INCLUDE + '#include "runtime/hm_math.h"\n', 1)
 
 
+# How every file CasADi writes ends: a file without it was cut short.
+_CASADI_END = '} /* extern "C" */\n#endif\n'
+
+
+def check_complete(path: Path) -> None:
+    """CasADi writes with C++ streams and reports no error: on a full file system it leaves a truncated
+    file (measured: 4096 of 10,911 bytes, no exception). Raise OSError when the file does not end as
+    CasADi ends every file, so the package is not moved into place."""
+    try:
+        with path.open("rb") as f:
+            f.seek(max(0, path.stat().st_size - len(_CASADI_END)))
+            tail = f.read().decode("ascii", errors="replace")
+    except OSError:
+        raise
+    if tail != _CASADI_END:
+        raise OSError(errno.EIO, "CasADi's output is cut short (is the file system full?)", str(path))
+
+
 def emit_model(functions: tuple[ModelFunction, ...], prefix: str, real: str, out_dir: Path) -> list[EmittedFunction]:
     """Write {prefix}_model.c/.h into out_dir; return what the templates need of each function."""
     basename = f"{prefix}_model"
@@ -154,6 +173,8 @@ def emit_model(functions: tuple[ModelFunction, ...], prefix: str, real: str, out
             )
         )
     cg.generate(str(out_dir) + "/")
+    for written in (out_dir / f"{basename}.c", out_dir / f"{basename}.h"):
+        check_complete(written)
     single = " single-precision math and literals," if real == "float" else ""
     banner = (
         f"/* {basename}.c: model functions of the humanmpc solver \"{prefix}\", written by CasADi "

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
-from .build import BuildError, build, read_manifest
+from .build import NATIVE_ENV, NATIVE_FLAGS, PORTABLE_CFLAGS, BuildError, build, built_flags, read_manifest
 from .generate import GenerateError, generate
 from .ros import write_ros
 from .spec import SpecError, describe_schema, load_spec
@@ -29,13 +29,21 @@ def _cmd_generate(args: argparse.Namespace) -> int:
     return 0
 
 
+# The system's Python, which has ROS's modules: catkin otherwise takes the first python3 on PATH, and a
+# virtual environment's stops the build with "No module named 'catkin_pkg'".
+CATKIN_MAKE = "catkin_make -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3"
+
+
 def _cmd_ros(args: argparse.Namespace) -> int:
-    print(write_ros(args.dir, args.output, force=args.force))
+    out = write_ros(args.dir, args.output, force=args.force)
+    print(out)
+    print(f"next: mkdir -p ~/ws/src && cp -r {out} ~/ws/src/ && cd ~/ws && {CATKIN_MAKE}  (docs/ros.md)",
+          file=sys.stderr)
     return 0
 
 
 def _cmd_build(args: argparse.Namespace) -> int:
-    lib = build(args.dir, cc=args.cc, cflags=args.cflags)
+    lib = build(args.dir, cc=args.cc, cflags=args.cflags, native=args.native)
     print(lib)
     return 0
 
@@ -102,6 +110,15 @@ def _cmd_info(args: argparse.Namespace) -> int:
     lib = d / str(m["library"])
     print(f"  library      {lib} ({lib.stat().st_size:,} B)" if lib.exists() else "  library      not built")
     if lib.exists():
+        flags = built_flags(d)
+        if flags is None:
+            print("  built with   unknown flags (built by another tool, or a Makefile of an older humanmpc)")
+        else:
+            native = "-march=native" in flags.split()
+            kind = ("tuned to the CPU it was built on: it may not run on another" if native
+                    else "portable: runs on any CPU of the architecture")
+            print(f"  built with   {flags}  ({kind})")
+    if lib.exists():
         print("  static memory (the structs a caller declares; nothing is allocated at run time)")
         for what, size in static_memory(lib, str(m["name"])):
             print(f"    {what:<34} {size:>11,} B")
@@ -157,8 +174,11 @@ def add_generator_commands(sub: argparse._SubParsersAction) -> None:
                        "DIR/build/lib<name>.so and .a.")
     p.add_argument("dir", type=Path, help="generated solver folder")
     p.add_argument("--cc", help="C compiler (default: $CC or cc)")
-    p.add_argument("--cflags", help="compiler flags (default: $CFLAGS, or tuned to this machine: "
-                   "-O2 -march=native -funroll-loops -ffp-contract=off)")
+    p.add_argument("--cflags", help=f"compiler flags (default: $CFLAGS, else the portable {PORTABLE_CFLAGS})")
+    p.add_argument("--native", action="store_true", default=None,
+                   help=f"tune the library to this machine's CPU ({NATIVE_FLAGS} after the flags): faster here, "
+                   "but it may not run on another CPU (the robot's); the same results bit for bit "
+                   f"(default: portable, unless ${NATIVE_ENV}=1)")
     p.set_defaults(func=_cmd_build)
 
     p = sub.add_parser("info", help="describe a generated package: sizes, files, functions",

@@ -15,7 +15,9 @@ import hashlib
 import io
 import json
 import math
+import os
 import re
+import stat
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,6 +25,7 @@ from typing import Any, cast
 
 import yaml
 
+from .names import clash, reserved_prefix
 from .params import BY_KEY, Param, paper_values
 
 
@@ -54,13 +57,17 @@ C_KEYWORDS = frozenset(
 )
 RESERVED_NAMES = frozenset({"hm", "casadi", "humanmpc", "main", "errno", "assert"})
 # The package writes <name>.h beside the sources that include the system's headers: a name that is
-# a standard C or common POSIX header's would shadow it (a spec named "time" silently replaced
-# <time.h>, and with it the deadline monitor's clock).
+# a standard C or POSIX header's would shadow it (a spec named "time" silently replaced <time.h>, and
+# with it the deadline monitor's clock). C99/C11/C23 headers, POSIX's, and common others.
 SYSTEM_HEADER_NAMES = frozenset({
     "assert", "complex", "ctype", "errno", "fenv", "float", "inttypes", "iso646", "limits", "locale", "math",
-    "setjmp", "signal", "stdalign", "stdarg", "stdatomic", "stdbool", "stddef", "stdint", "stdio", "stdlib",
-    "stdnoreturn", "string", "tgmath", "threads", "time", "uchar", "wchar", "wctype", "unistd", "pthread",
-    "sched", "fcntl", "strings", "alloca", "malloc", "features", "endian", "cffi", "casadi",
+    "setjmp", "signal", "stdalign", "stdarg", "stdatomic", "stdbit", "stdbool", "stdckdint", "stddef", "stdint",
+    "stdio", "stdlib", "stdnoreturn", "string", "tgmath", "threads", "time", "uchar", "wchar", "wctype",
+    "aio", "arpa", "cpio", "dirent", "dlfcn", "fcntl", "fmtmsg", "fnmatch", "ftw", "glob", "grp", "iconv",
+    "langinfo", "libgen", "monetary", "mqueue", "ndbm", "net", "netdb", "netinet", "nl_types", "poll",
+    "pthread", "pwd", "regex", "sched", "search", "semaphore", "spawn", "strings", "stropts", "sys", "syslog",
+    "tar", "termios", "trace", "ulimit", "unistd", "utime", "utmpx", "wordexp", "alloca", "malloc", "features",
+    "endian", "memory", "cffi", "casadi", "printf",
 })
 # Matched with fullmatch: "$" alone also matches before a trailing newline.
 IDENT_RE = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
@@ -150,6 +157,17 @@ class Rule:
         if value.lower() in SYSTEM_HEADER_NAMES:
             return None, [f"{path}: {value!r} is reserved: the package's {value}.h would shadow the system header "
                           f"<{value.lower()}.h>: choose another name"]
+        if value != value.lower():
+            return None, [f"{path}: {value!r} has capital letters: the name becomes file names (one file on a "
+                          f"case-insensitive file system) and upper-case macros ({value.upper()}_N), the same for "
+                          f"{value.lower()!r}: use lower case"]
+        why = reserved_prefix(value)
+        if why is not None:
+            return None, [f"{path}: {value!r} is reserved: its external symbols ({value}_solver_step, ...) would "
+                          f"begin like {why}: choose another name"]
+        found = clash(value)
+        if found is not None:
+            return None, [f"{path}: {value!r} could clash with another package: {found.explain()}"]
         return value, []
 
 
@@ -497,15 +515,92 @@ _UniqueKeyLoader.add_constructor(
 )
 
 
-# A spec is a few dozen lines: anything much larger is a mistake (or an attack on the loader).
+# A spec is a few dozen lines, a few levels deep: anything much larger or deeper is a mistake (or an
+# attack on the loader: PyYAML composes nested collections recursively, 400 levels in 1 KB raised
+# RecursionError).
 MAX_SPEC_BYTES = 64 * 1024
+MAX_SPEC_DEPTH = 16
+
+
+def _line_text(text: str, line: int) -> str:
+    """Line ``line`` (0-based) of text, stripped and cut short, for a message."""
+    lines = text.splitlines()
+    got = lines[line].strip() if 0 <= line < len(lines) else ""
+    return got if len(got) <= 60 else got[:57] + "..."
+
+
+def _yaml_problem(err: yaml.MarkedYAMLError, text: str) -> str:
+    """PyYAML's error in our words, naming the line of the mistake: PyYAML marks where it noticed it,
+    for a key without ':' or an unclosed bracket or quote the line after; its context mark is the line
+    where the unfinished thing began."""
+    problem = err.problem or "a syntax error"
+    context = err.context or ""
+    pm, cm = err.problem_mark, err.context_mark
+    at = pm.line if pm is not None else 0
+    began = cm.line if cm is not None else at
+    if "simple key" in context:
+        return (f"line {began + 1}: {_line_text(text, began)!r} is a key without ':' (write 'key: value'); "
+                f"not valid YAML")
+    if "flow" in context:
+        return (f"line {began + 1}: a '[' or '{{' opened on this line is not closed ({problem} on line {at + 1}); "
+                "not valid YAML")
+    if "quoted scalar" in context:
+        return f"line {began + 1}: a quoted string opened on this line is not closed; not valid YAML"
+    if "'\\t'" in problem:
+        return f"line {at + 1}: a tab character: indent with spaces; not valid YAML"
+    if "another document" in problem:
+        return f"line {at + 1}: a second YAML document ('---'): a spec is one document; not valid YAML"
+    if "mapping values are not allowed" in problem:
+        return (f"line {at + 1}: {_line_text(text, at)!r} has a ':' where YAML cannot start a key: quote a value "
+                "that holds ': ', or indent the key under its section; not valid YAML")
+    if "block end" in problem:
+        return (f"line {at + 1}: {_line_text(text, at)!r} does not fit the indentation or the lines above "
+                f"({problem}); not valid YAML")
+    where = f" ({context} from line {began + 1})" if context and began != at else ""
+    return f"line {at + 1}: {problem}{where}; not valid YAML"
+
+
+def _reader_problem(err: yaml.reader.ReaderError, text: str) -> str:
+    """A character YAML does not accept (a control character), by line and column."""
+    line = text.count("\n", 0, err.position) + 1
+    column = err.position - (text.rfind("\n", 0, err.position) + 1) + 1
+    char = err.character if isinstance(err.character, int) else ord(err.character)
+    return (f"line {line}, column {column}: the character U+{char:04X} is not allowed in YAML "
+            "(a control character): remove it; not valid YAML")
+
+
+def _yaml_error(err: yaml.YAMLError, text: str) -> str:
+    if isinstance(err, yaml.MarkedYAMLError):
+        return _yaml_problem(err, text)
+    if isinstance(err, yaml.reader.ReaderError):
+        return _reader_problem(err, text)
+    return f"not valid YAML: {err}"
+
+
+def _check_depth(text: str, source: str) -> None:
+    """Refuse collections nested deeper than MAX_SPEC_DEPTH by scanning the parser's events, which
+    PyYAML produces without recursion, before anything is composed."""
+    depth = 0
+    try:
+        for event in yaml.parse(io.StringIO(text), Loader=_UniqueKeyLoader):
+            if isinstance(event, yaml.CollectionStartEvent):
+                depth += 1
+                if depth > MAX_SPEC_DEPTH:
+                    line = event.start_mark.line + 1 if event.start_mark is not None else 0
+                    raise SpecError([f"line {line}: lists and maps nested more than {MAX_SPEC_DEPTH} deep: a spec "
+                                     "is a few levels deep (see humanmpc-gen keys)"], source)
+            elif isinstance(event, yaml.CollectionEndEvent):
+                depth -= 1
+    except yaml.YAMLError as err:
+        raise SpecError([_yaml_error(err, text)], source) from None
 
 
 def _parse_yaml(text: str, source: str) -> Any:
-    """The YAML document in text: safe loader, duplicate keys and aliases refused, size bounded,
-    errors naming the source."""
+    """The YAML document in text: safe loader, duplicate keys and aliases refused, size and nesting
+    bounded, errors naming the source and the line."""
     if len(text.encode("utf-8", errors="replace")) > MAX_SPEC_BYTES:
         raise SpecError([f"the spec is {len(text):,} characters long: at most {MAX_SPEC_BYTES:,} bytes"], source)
+    _check_depth(text, source)
     stream = io.StringIO(text)
     stream.name = source  # PyYAML names this in its error marks
     try:
@@ -513,7 +608,7 @@ def _parse_yaml(text: str, source: str) -> Any:
     except SpecError as err:
         raise SpecError(err.problems, source) from None
     except yaml.YAMLError as err:
-        raise SpecError([f"not valid YAML: {err}"], source) from None
+        raise SpecError([_yaml_error(err, text)], source) from None
 
 
 def parse_spec_text(text: str, source: str = "spec") -> Spec:
@@ -521,19 +616,44 @@ def parse_spec_text(text: str, source: str = "spec") -> Spec:
     return resolve_spec(_parse_yaml(text, source), source)
 
 
+_FILE_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+               (stat.S_ISFIFO, "a pipe (FIFO)"), (stat.S_ISSOCK, "a socket"))
+
+
+def read_spec_file(path: Path) -> str:
+    """The text of the spec file at path, read with bounds whatever the path is: a regular file of at most
+    MAX_SPEC_BYTES (at most that many bytes are read, so a file that grows or lies about its size, such as
+    one under /proc, cannot exhaust memory); a device, pipe, socket or folder is refused without reading
+    from it (opened non-blocking, so a FIFO without a writer cannot hang the command)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+    except OSError as err:
+        raise SpecError([f"cannot read {path}: {err.strerror}"], str(path)) from None
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            kind = next((what for test, what in _FILE_KINDS if test(mode)), "not a regular file")
+            raise SpecError([f"{path} is {kind}, not a spec file: give a YAML file"], str(path))
+        with os.fdopen(os.dup(fd), "rb") as f:
+            data = f.read(MAX_SPEC_BYTES + 1)
+    except OSError as err:
+        raise SpecError([f"cannot read {path}: {err.strerror}"], str(path)) from None
+    finally:
+        os.close(fd)
+    if len(data) > MAX_SPEC_BYTES:
+        raise SpecError([f"{path} is larger than {MAX_SPEC_BYTES:,} bytes, the most a spec may be"], str(path))
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise SpecError([f"{path} is not UTF-8 text: {err.reason} at byte {err.start}"], str(path)) from None
+
+
 def load_spec(path: str | Path | None) -> Spec:
     """The spec in the YAML file at ``path``, or the built-in default spec when ``path`` is None."""
     if path is None:
         return Spec()
     p = Path(path)
-    try:
-        if p.stat().st_size > MAX_SPEC_BYTES:
-            raise SpecError([f"{p} is {p.stat().st_size:,} bytes: a spec is at most {MAX_SPEC_BYTES:,}"], str(p))
-        text = p.read_text(encoding="utf-8")
-    except OSError as err:
-        raise SpecError([f"cannot read {p}: {err.strerror}"], str(p)) from None
-    except UnicodeDecodeError as err:
-        raise SpecError([f"{p} is not UTF-8 text: {err.reason} at byte {err.start}"], str(p)) from None
+    text = read_spec_file(p)
     data = _parse_yaml(text, str(p))
     if data is None:
         raise SpecError([f"{p} holds no keys: write at least one (e.g. name: mysolver), or give no file to use "

@@ -197,22 +197,26 @@ def test_every_command_has_help(command: list[str], capsys: pytest.CaptureFixtur
     assert "usage: humanmpc-gen" in capsys.readouterr().out
 
 
-def test_host_tuned_build_gives_the_same_bits_as_a_portable_one(tmp_path: Path) -> None:
-    """The Python library is built with HOST_CFLAGS (SIMD for this CPU, IEEE arithmetic kept): a
-    closed loop gives bit-identical results to the same package built with plain -O2."""
+def test_a_native_build_gives_the_same_bits_as_the_portable_default(tmp_path: Path) -> None:
+    """Portable by default; --native adds -march=native -funroll-loops for this CPU, IEEE arithmetic kept
+    (-ffp-contract=off in both): a closed loop gives bit-identical results either way."""
     import shutil
 
     import numpy as np
 
-    from humanmpc.codegen.build import HOST_CFLAGS, PORTABLE_CFLAGS, host_cflags
+    from humanmpc.codegen.build import NATIVE_FLAGS, PORTABLE_CFLAGS, built_flags, native_supported
     from humanmpc.compare.replay import synthetic_replay
 
-    assert host_cflags("gcc") == HOST_CFLAGS  # gcc on the development machines takes them
+    assert native_supported("gcc")  # gcc on the development machines takes them
     d = make_solver(tmp_path, {"name": "flags", "humans": {"max": 4}}, built=False)
     portable = tmp_path / "portable" / "flags"
     shutil.copytree(d, portable)
-    build(d, cflags=HOST_CFLAGS, log=QUIET)
-    build(portable, cflags=PORTABLE_CFLAGS, log=QUIET)
+    build(d, cc="gcc", native=True, log=QUIET)
+    build(portable, cc="gcc", log=QUIET)
+    native_flags, portable_flags = built_flags(d), built_flags(portable)
+    assert native_flags is not None and portable_flags is not None
+    assert f"{PORTABLE_CFLAGS} {NATIVE_FLAGS}" in native_flags
+    assert PORTABLE_CFLAGS in portable_flags and "-march" not in portable_flags
     replay = synthetic_replay(resolve_spec({"name": "flags", "humans": {"max": 4}}), 4, 40, seed=5)
     runs = []
     for path in (d, portable):
@@ -222,3 +226,41 @@ def test_host_tuned_build_gives_the_same_bits_as_a_portable_one(tmp_path: Path) 
     for a, b in zip(*runs, strict=True):
         assert a.stop_reason == b.stop_reason and a.qp_iterations == b.qp_iterations
         assert np.array_equal(a.x, b.x) and np.array_equal(a.u, b.u)
+
+
+def test_cli_build_is_portable_by_default_native_on_request_and_info_says_which(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    """humanmpc-gen build compiled with -march=native while the package's Makefile used -O2: now both are
+    portable unless asked, a change of flags rebuilds, and info reports the flags of the built library."""
+    monkeypatch.delenv("CFLAGS", raising=False)
+    monkeypatch.delenv("HUMANMPC_NATIVE", raising=False)
+    d = make_solver(tmp_path, {"name": "pol", "horizon": {"N": 4}, "humans": {"max": 1}}, built=False)
+    assert cli.main(["build", str(d)]) == 0
+    assert cli.main(["info", str(d)]) == 0
+    out = capsys.readouterr()
+    assert "portable" in out.err and "-march=native" not in out.err
+    line = next(ln for ln in out.out.splitlines() if ln.strip().startswith("built with"))
+    assert "-O2 -ffp-contract=off" in line and "-march=native" not in line and "(portable" in line
+    portable_lib = (d / "build" / "libpol.so").read_bytes()
+    assert cli.main(["build", str(d), "--native"]) == 0
+    assert cli.main(["info", str(d)]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.strip().startswith("built with"))
+    assert "-march=native -funroll-loops" in line and "may not run on another" in line
+    assert (d / "build" / "libpol.so").read_bytes() != portable_lib  # the new flags rebuilt it
+    # the Makefile alone: the same policy (make -n prints the compile commands)
+    run(["make", "-C", str(d), "clean"])
+    plain = run(["make", "-n", "-C", str(d), "--no-print-directory"])
+    native = run(["make", "-n", "-C", str(d), "--no-print-directory", "NATIVE=1"])
+    assert "-O2 -ffp-contract=off" in plain and "-march=native" not in plain
+    assert "-O2 -ffp-contract=off -march=native -funroll-loops" in native
+
+
+def test_cmake_follows_the_same_flag_policy(paper_dir: Path, tmp_path: Path) -> None:
+    cmake = require_tool("cmake")
+    for native in ("OFF", "ON"):
+        build_dir = tmp_path / f"cmake-{native}"
+        run([cmake, "-S", str(paper_dir), "-B", str(build_dir), "-DCMAKE_EXPORT_COMPILE_COMMANDS=ON",
+             f"-DHUMANMPC_NATIVE={native}"])
+        commands = (build_dir / "compile_commands.json").read_text()
+        assert "-O2" in commands and "-O3" not in commands and "-ffp-contract=off" in commands
+        assert ("-march=native" in commands) == (native == "ON")

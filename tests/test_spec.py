@@ -3,7 +3,12 @@
 from __future__ import annotations
 
 import math
+import os
 import re
+import resource
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -215,9 +220,72 @@ def test_a_number_too_large_for_a_double_is_an_error_not_a_traceback(tmp_path: P
             parse_spec_text(text)
 
 
-def test_a_yaml_syntax_error_names_the_file(tmp_path: Path) -> None:
-    f = tmp_path / "tabs.yaml"
-    f.write_text("horizon:\n\tN: 50\n")
+@pytest.mark.parametrize(("text", "line", "words"), [
+    ("name: a\nhorizon\n  N: 5\nsolver:\n  x: 1\n", 2, "'horizon' is a key without ':'"),
+    ("name: a\nbounds: {v: [0, 1]\nsolver: 3\n", 2, "is not closed"),
+    ("name: \"abc\nx: 1\n", 1, "quoted string opened on this line is not closed"),
+    ("horizon:\n\tN: 50\n", 2, "tab character: indent with spaces"),
+    ("horizon:\n    N: 5\n  T: 3\n", 3, "'T: 3' does not fit the indentation"),
+    ("name: a: b\n", 1, "quote a value"),
+    ("name: a\nx: \x01\n", 2, "U+0001 is not allowed in YAML"),
+    ("name: a\n---\nname: b\n", 2, "a spec is one document"),
+])
+def test_a_yaml_syntax_error_names_the_file_and_the_line_of_the_mistake(tmp_path: Path, text: str, line: int,
+                                                                        words: str) -> None:
+    """PyYAML marks the line after a key without ':' or an unclosed bracket or quote, in its own words;
+    the message names the file, the line where the mistake is, and what to write instead."""
+    f = tmp_path / "typo.yaml"
+    f.write_text(text)
     with pytest.raises(SpecError) as info:
         load_spec(f)
-    assert 'in "' + str(f) + '", line 2' in str(info.value)
+    assert str(info.value).startswith(f"invalid {f}:")
+    assert info.value.problems[0].startswith((f"line {line}: ", f"line {line}, ")), info.value.problems
+    assert words in info.value.problems[0]
+    assert "while scanning" not in str(info.value) and "while parsing" not in str(info.value)
+
+
+def _check_in_a_child(path: str) -> subprocess.CompletedProcess[str]:
+    """humanmpc-gen check PATH in a process with 1 GB of address space and 60 s: reading /dev/zero
+    whole grew to 6.9 GB, /dev/urandom and a FIFO without a writer hung."""
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (1 << 30, 1 << 30))
+
+    return subprocess.run([sys.executable, "-m", "humanmpc.codegen", "check", path], capture_output=True, text=True,
+                          timeout=60, preexec_fn=limit, check=False)
+
+
+@pytest.mark.parametrize(("path", "kind"), [("/dev/zero", "a character device"),
+                                            ("/dev/urandom", "a character device"),
+                                            ("{tmp}", "a folder"), ("{tmp}/fifo", "a pipe (FIFO)")])
+def test_a_spec_path_that_is_not_a_regular_file_is_refused_without_reading_it(tmp_path: Path, path: str,
+                                                                              kind: str) -> None:
+    os.mkfifo(tmp_path / "fifo")
+    path = path.format(tmp=tmp_path)
+    t0 = time.monotonic()
+    proc = _check_in_a_child(path)
+    assert proc.returncode == 2, proc.stderr
+    assert f"{path} is {kind}, not a spec file" in proc.stderr and "Traceback" not in proc.stderr
+    assert time.monotonic() - t0 < 30
+
+
+def test_a_huge_spec_file_is_refused_after_reading_a_bounded_prefix(tmp_path: Path) -> None:
+    """A sparse 8 GB file: the size is not trusted (files under /proc say 0), the read is bounded."""
+    big = tmp_path / "big.yaml"
+    with big.open("wb") as f:
+        f.truncate(8 << 30)
+    proc = _check_in_a_child(str(big))
+    assert proc.returncode == 2 and f"{big} is larger than 65,536 bytes" in proc.stderr, proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize("opening", ["[", "{a: ", "- "])
+def test_deeply_nested_lists_or_maps_are_refused_naming_the_file(tmp_path: Path, opening: str) -> None:
+    """400 nested lists or maps in a 1 KB spec raised RecursionError in PyYAML's composer."""
+    closing = {"[": "]", "{a: ": "}", "- ": ""}[opening]
+    f = tmp_path / "deep.yaml"
+    f.write_text("name: deep\nweights:\n  " + opening * 400 + "1" + closing * 400 + "\n")
+    assert f.stat().st_size < 2100
+    proc = _check_in_a_child(str(f))
+    assert proc.returncode == 2, proc.stderr
+    assert f"invalid {f}" in proc.stderr and "nested more than 16 deep" in proc.stderr
+    assert "Traceback" not in proc.stderr and "RecursionError" not in proc.stderr

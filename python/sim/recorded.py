@@ -176,10 +176,16 @@ def pedestrian_data_dir() -> Path:
     for folder in candidates:
         if folder.is_dir():
             return folder
-    looked = ", ".join(str(c) for c in candidates)
+    if env:
+        where = f"${PEDESTRIANS_ENV} is {env!r}, which is not a folder"
+    else:
+        unique = list(dict.fromkeys(str(c) for c in candidates))  # from the checkout, both are the same
+        where = f"{PEDESTRIANS_ENV} is not set, and there is no folder {' or '.join(unique)}"
     raise FileNotFoundError(
-        f"the recorded pedestrian data was not found (looked in {looked}); set {PEDESTRIANS_ENV} to the folder "
-        "holding biwi_eth.txt, biwi_hotel.txt and crowds_zara01.txt"
+        "the recorded pedestrian trajectories were not found: " + where + ". They are the ETH/UCY recordings "
+        "(biwi_eth.txt and biwi_hotel.txt of the BIWI Walking Pedestrians dataset, crowds_zara01.txt of UCY's "
+        "Crowds by Example, as redistributed for trajectory-prediction research); "
+        f"set {PEDESTRIANS_ENV} to the folder that holds them"
     )
 
 
