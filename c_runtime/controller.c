@@ -34,6 +34,7 @@
 
 #include "controller_goal.h"
 #include "controller_people.h"
+#include "controller_safety.h"
 #include "monitor.h"
 #include "ocp_nlp_lin.h"
 #include "ocp_nlp_out.h"
@@ -66,7 +67,7 @@ static int controller_input_ok(const hm_controller_input *cin)
         return 0;
     if (cin->n_path < 0 || cin->n_path > HM_MAX_PATH_POINTS || cin->n_tracks < 0 ||
         cin->n_tracks > HM_MAX_TRACKS || cin->n_obstacles < 0 || cin->n_obstacles > HM_MAX_OBSTACLE_POINTS ||
-        (cin->has_goal != 0 && cin->has_goal != 1))
+        (cin->has_goal != 0 && cin->has_goal != 1) || cin->n_tracks_dropped < 0)
         return 0;
     if (cin->has_goal && (!monitor_position_ok(cin->goal) || !(hm_fabs(cin->goal[2]) <= HM_MONITOR_MAX_ANGLE)))
         return 0;
@@ -96,6 +97,7 @@ HM_FUNC void controller_reset(hm_controller *c)
     c->has_time = 0;
     c->has_recovery = 0;
     c->has_theta = 0;
+    c->has_origin = 0;
     c->best_left = HM_INF;
     c->time_progress = HM_R(0.0);
     c->time_brisk = HM_R(0.0);
@@ -111,6 +113,7 @@ HM_FUNC void controller_init(hm_controller *c, const hm_params *params)
     ocp_nlp_sqp_init(&c->solver, params);
     c->in.n_humans = 0;
     c->in.has_obstacle = 0;
+    c->in.has_refs = 0;
     for (j = 0; j < 2; j++) c->in.obstacle[j] = HM_R(0.0);
     controller_reset(c);
 }
@@ -127,6 +130,13 @@ static void controller_solver_params(hm_controller *c, const hm_controller_goal 
     hm_real v_arrive, arrival;
     *sp = *p;
     if (cap > p->v_bounds[0]) sp->v_bounds[1] = cap;
+    if (p->progress) {
+        /* the per-node goals brake to the goal themselves (controller_references): no taper, no approach */
+        int i;
+        for (i = 0; i < HM_NX; i++) sp->w_goal[i] = p->progress_weights[i];
+        c->in.goal[3] = p->v_ref;
+        return;
+    }
     c->in.goal[3] = hm_fmin(p->v_ref, p->goal_taper * g->left);
     if (p->approach && g->left < p->v_ref * horizon) {
         sp->w_goal[3] = HM_R(0.0);
@@ -146,6 +156,49 @@ static void controller_solver_params(hm_controller *c, const hm_controller_goal 
                   v_arrive / (HM_R(2.0) * p->a_bounds[1]) + p->arrival_margin;
         sp->collision_horizon = hm_fmin(p->collision_horizon, arrival);
     }
+}
+
+/* Where a straight path to a goal pose given alone starts: with the progress objective, where the robot
+ * was when it got that goal (the line must not move with the robot, or walking off sideways would cost
+ * nothing); else the robot itself (the carrot of the paper's objective). */
+static const hm_real *controller_origin(hm_controller *c, const hm_controller_input *cin)
+{
+    const hm_real *end = cin->n_path == 1 ? cin->path[0] : cin->goal;
+    if (!c->params.progress || cin->n_path >= 2) return cin->pose;
+    if (!c->has_origin || c->origin_goal[0] != end[0] || c->origin_goal[1] != end[1]) {
+        c->origin[0] = cin->pose[0];
+        c->origin[1] = cin->pose[1];
+        c->origin_goal[0] = end[0];
+        c->origin_goal[1] = end[1];
+        c->has_origin = 1;
+    }
+    return c->origin;
+}
+
+/* The progress objective's goal per node (params.progress): node n's goal is the point of the path where
+ * a robot that started at its projection now would be at node n's time, going at the speed it could go:
+ * from its measured speed (at least 0), accelerating at the upper bound towards the speed to track
+ * (in->goal[3]: the cruising speed, lowered by speed and separation), and braking at half the lower bound
+ * to arrive at the goal at rest; heading: the path's there; speed: that speed. Motion that does not bring
+ * the robot along its path falls behind these goals and costs; so does standing, once they have moved on.
+ * Sets in->refs and in->has_refs. */
+static void controller_references(hm_controller *c, const hm_controller_input *cin, const hm_controller_goal *g)
+{
+    hm_input *in = &c->in;
+    const hm_params *sp = &c->solver.params;
+    const hm_real dt = HM_R(HM_DT), a_up = sp->a_bounds[1], a_down = HM_R(-0.5) * sp->a_bounds[0];
+    hm_real v = hm_fmin(hm_fmax(cin->v, HM_R(0.0)), in->goal[3]), d = HM_R(0.0);
+    int n;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_real left = hm_fmax(g->length - g->s_proj - d, HM_R(0.0));
+        hm_real *r = in->refs[n];
+        controller_path_at(cin, controller_origin(c, cin), in->x0[2], g->s_proj + d, g, r);
+        r[3] = v;
+        d += v * dt;
+        v = hm_fmin(hm_fmin(in->goal[3], v + a_up * dt),
+                    hm_sqrt(HM_R(2.0) * a_down * hm_fmax(left - v * dt, HM_R(0.0))));
+    }
+    in->has_refs = 1;
 }
 
 /* The length of a planned path. */
@@ -328,33 +381,24 @@ static void controller_brake(hm_controller *c)
 /* What the robot does within goal_tolerance of its goal (controller_at_goal). */
 enum controller_at_goal_state {
     CONTROLLER_GOAL_DONE,    /* the heading is within yaw_goal_tolerance, or there is none to meet: braking */
-    CONTROLLER_GOAL_TURNING, /* braking, then turning in place to the goal's heading */
-    CONTROLLER_GOAL_HELD     /* the turn is due but someone is within d_h: a protective stop */
+    CONTROLLER_GOAL_TURNING  /* braking, then turning in place to the goal's heading */
 };
 
 /* Within goal_tolerance of a goal pose whose heading is more than yaw_goal_tolerance off: brake, then turn
  * in place towards the heading (the turn rate CONTROLLER_TURN_GAIN times the heading's error, within the
- * turn-rate bounds), unless someone is within d_h: then the paper's C2 holds it in a protective stop until
- * they leave. The OCP, cut off at goal_tolerance, would leave the robot facing the way it came (up to 170
- * degrees off the goal's heading: docs/evaluation.md); nav2's goal checkers test the heading too. A path
- * without a goal pose has no heading to meet. c->out: the braking plan, with the turn or the stop. */
+ * turn-rate bounds); someone within d_h holds it in a protective stop (controller_guard). The OCP, cut off
+ * at goal_tolerance, would leave the robot facing the way it came (up to 170 degrees off the goal's
+ * heading); nav2's goal checkers test the heading too. A path without a goal pose has no heading to meet.
+ * c->out: the braking plan, with the turn. */
 static enum controller_at_goal_state controller_at_goal(hm_controller *c, const hm_controller_input *cin,
                                                         hm_real heading)
 {
     const hm_params *p = &c->params;
     hm_output *o = &c->out;
     hm_real A[HM_NX * HM_NX], B[HM_NX * HM_NU];
-    int n, i;
+    int n;
     controller_brake(c);
     if (cin->has_goal != 1 || !(hm_fabs(heading - c->in.x0[2]) > p->yaw_goal_tolerance)) return CONTROLLER_GOAL_DONE;
-    for (i = 0; i < cin->n_tracks; i++) {
-        const hm_real dx = cin->tracks[i][0] - c->in.x0[0], dy = cin->tracks[i][1] - c->in.x0[1];
-        if (dx * dx + dy * dy < p->d_h * p->d_h) {
-            o->stop = 1;
-            o->stop_reason = HM_STOP_HUMAN_TOO_CLOSE;
-            return CONTROLLER_GOAL_HELD;
-        }
-    }
     for (n = 0; n < HM_N; n++) {
         /* brake first, then turn: turning while still rolling would swing the robot off the goal */
         const hm_real w = hm_fabs(o->x[n][3]) < CONTROLLER_AT_REST ? CONTROLLER_TURN_GAIN * (heading - o->x[n][2])
@@ -444,42 +488,43 @@ static void controller_report(const hm_controller *c, hm_controller_output *out)
     if (o->stop) out->outcome = HM_OUTCOME_STOPPED;
 }
 
-HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm_controller_output *out)
+/* The heading the OCP sees winds continuously (odometry's wrap at +-pi would be a jump of 2 pi), but not
+ * without bound: a robot that keeps turning one way would reach the inputs' limit (1e4 rad, 2.8 h at
+ * 1 rad/s) and stop for good. Beyond this many radians the unwound heading, the solver's plan and its
+ * last state are moved back by whole turns, which changes nothing the OCP sees (its dynamics and costs
+ * read headings through sin and cos, and the carrot's heading is unwound to the robot's). */
+#define CONTROLLER_HEADING_WIND HM_R(64.0)
+
+/* The measured heading unwound against the last period's, kept within CONTROLLER_HEADING_WIND. */
+static hm_real controller_heading(hm_controller *c, hm_real measured)
+{
+    hm_solver *s = &c->solver;
+    hm_real theta = c->has_theta ? controller_unwrap(measured, c->theta) : measured;
+    if (hm_fabs(theta) > CONTROLLER_HEADING_WIND) {
+        const hm_real shift = theta - controller_unwrap(measured, HM_R(0.0));
+        int n;
+        theta -= shift;
+        for (n = 0; n <= HM_N; n++) s->x[n][2] -= shift;
+        s->x0_last[2] -= shift;
+    }
+    c->theta = theta;
+    c->has_theta = 1;
+    return theta;
+}
+
+/* The period's path: what the robot does, into c->out (and out's flags); returns 1 when c->out is the
+ * controller's own braking plan (at the goal, without a goal), 0 for a plan of the solver's. */
+static int controller_plan(hm_controller *c, const hm_controller_input *cin, unsigned long long t0,
+                           hm_controller_output *out)
 {
     hm_solver *s = &c->solver;
     hm_input *in = &c->in;
-    const unsigned long long t0 = ocp_nlp_now(s);
     const hm_real horizon = HM_R(HM_DT) * (hm_real)HM_N;
     hm_controller_goal g;
     hm_real path[HM_N + 1][2];
     unsigned long long t1;
     int slow = 0;
-    controller_clear_output(out);
-    in->n_humans = 0;
-    in->has_obstacle = 0;
-    in->x0[0] = cin->pose[0];
-    in->x0[1] = cin->pose[1];
-    in->x0[2] = cin->pose[2];
-    in->x0[3] = cin->v;
-    if (!controller_input_ok(cin) || !monitor_check_params(&c->params)) {
-        int i;
-        const int reason = monitor_check_params(&c->params) ? HM_STOP_INVALID_INPUT : HM_STOP_INVALID_PARAMS;
-        for (i = 0; i < HM_NX; i++) in->goal[i] = in->x0[i];
-        s->params = c->params;
-        ocp_nlp_clear_output(&c->out);
-        ocp_nlp_protective_stop(s, in, &c->out, reason);
-        ocp_nlp_sqp_reset(s);
-        c->has_time = 0;
-        c->has_theta = 0;
-        controller_report(c, out);
-        out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
-        return out->outcome;
-    }
-    /* headings wind continuously for the OCP: odometry's wrap at +-pi would be a jump of 2 pi */
-    if (c->has_theta) in->x0[2] = controller_unwrap(cin->pose[2], c->theta);
-    c->theta = in->x0[2];
-    c->has_theta = 1;
-    controller_goal(cin, cin->pose, in->x0[2],
+    controller_goal(cin, controller_origin(c, cin), cin->pose, in->x0[2],
                     c->params.lookahead > HM_R(0.0) ? c->params.lookahead : c->params.v_ref * horizon, &g);
     if (!g.has) {
         s->params = c->params;
@@ -488,11 +533,9 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
         in->goal[2] = in->x0[2];
         in->goal[3] = HM_R(0.0);
         controller_brake(c);
-        controller_report(c, out);
         out->outcome = HM_OUTCOME_NO_GOAL;
         c->has_goal = 0;
-        out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
-        return out->outcome;
+        return 1;
     }
     out->distance_to_goal = g.left;
     in->goal[0] = g.carrot[0];
@@ -501,12 +544,10 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
     controller_solver_params(c, &g);
     if (g.to_final <= c->params.goal_tolerance) {
         const enum controller_at_goal_state state = controller_at_goal(c, cin, g.final[2]);
-        controller_report(c, out);   /* a held turn: the outcome "stopped", with its reason */
         if (state == CONTROLLER_GOAL_DONE) out->outcome = HM_OUTCOME_GOAL_REACHED;
         out->goal_reached = state == CONTROLLER_GOAL_DONE;
         controller_progress(c, cin, &g, 1, &slow, out);
-        out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
-        return out->outcome;
+        return 1;
     }
     /* A speed to track that the robot may not use towards its goal rewards the plan for spending it
      * elsewhere: with people between it and the goal, it circled at cruising speed. */
@@ -517,11 +558,12 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
             in->goal[3] = hm_fmin(in->goal[3], controller_separation_bound(cin, in->x0, dx / len, dy / len, in->goal[3],
                                                                            &c->params));
     }
+    if (c->params.progress) controller_references(c, cin, &g);
     controller_expected_path(s, cin, path);
-    controller_select_people(path, cin, in, out);
+    controller_select_people(path, cin, &s->params, hm_fmax(hm_fabs(cin->v), s->params.v_bounds[1]), in, out);
     controller_nearest_obstacle(path, cin, c->solver.params.v_bounds[1], in);
     t1 = ocp_nlp_now(s);
-    ocp_nlp_sqp_rti_step(s, in, &c->out);
+    ocp_nlp_sqp_rti_step_from(s, in, &c->out, t0);
     out->time_solver_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t1);
     if (!c->out.stop && c->params.recovery_iterations > 0 && controller_is_loop(&c->params, &c->out)) {
         out->loop_detected = 1;
@@ -532,16 +574,41 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
         out->recovered = controller_recover_paced(c, cin, t0, CONTROLLER_START_TURN, out);
     if ((out->stalled || slow) && controller_may_recover(c, cin, out))
         out->recovered = controller_recover_paced(c, cin, t0, CONTROLLER_START_SIDEWAYS, out);
-    /* the OCP sees N_h people; the command must keep its distance from every track */
-    if (!c->out.stop) {
-        const hm_real v = c->out.command[0];
-        const hm_real bound = controller_separation_bound(cin, in->x0, hm_cos(in->x0[2]), hm_sin(in->x0[2]), v,
-                                                          &c->params);
-        if (monitor_separation_exceeded(v, bound, &c->params))
-            ocp_nlp_protective_stop(s, in, &c->out, HM_STOP_SEPARATION);
+    if (out->stalled) out->outcome = HM_OUTCOME_STALLED;
+    return 0;
+}
+
+HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm_controller_output *out)
+{
+    hm_solver *s = &c->solver;
+    hm_input *in = &c->in;
+    const unsigned long long t0 = ocp_nlp_now(s);
+    controller_clear_output(out);
+    in->n_humans = 0;
+    in->has_obstacle = 0;
+    in->has_refs = 0;
+    in->x0[0] = cin->pose[0];
+    in->x0[1] = cin->pose[1];
+    in->x0[2] = cin->pose[2];
+    in->x0[3] = cin->v;
+    out->n_tracks_dropped = cin->n_tracks_dropped;
+    if (!controller_input_ok(cin) || !monitor_check_params(&c->params)) {
+        int i;
+        const int reason = monitor_check_params(&c->params) ? HM_STOP_INVALID_INPUT : HM_STOP_INVALID_PARAMS;
+        for (i = 0; i < HM_NX; i++) in->goal[i] = in->x0[i];
+        s->params = c->params;
+        ocp_nlp_clear_output(&c->out);
+        ocp_nlp_protective_stop(s, in, &c->out, reason);
+        ocp_nlp_sqp_reset(s);
+        c->has_time = 0;
+        c->has_theta = 0;
+    } else {
+        int braking;
+        in->x0[2] = controller_heading(c, cin->pose[2]);
+        braking = controller_plan(c, cin, t0, out);
+        controller_guard(c, cin, t0, braking);
     }
-    controller_report(c, out);
-    if (out->stalled && !out->stop) out->outcome = HM_OUTCOME_STALLED;
+    controller_report(c, out);   /* a stop: the outcome "stopped", with its reason */
     out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
     return out->outcome;
 }

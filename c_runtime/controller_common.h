@@ -28,6 +28,8 @@ typedef struct hm_controller_goal {
     hm_real final[3];     /* the final goal [x, y, theta] */
     hm_real left;         /* [m] distance left along the path from the robot's projection */
     hm_real to_final;     /* [m] straight distance from the robot to the final goal */
+    hm_real s_proj;       /* [m] the robot's projection: arc length along the path from its start */
+    hm_real length;       /* [m] the path's length */
 } hm_controller_goal;
 
 /* angle + 2 pi k nearest to reference */

@@ -6,7 +6,9 @@
  * comes near over the horizon: someone 3 m away walking straight at the robot matters more than
  * someone 2 m away walking off. A track's relevance is the smallest distance between its prediction
  * and the robot's expected path at the same node, less two standard deviations of its position when
- * the tracker gives a covariance (an uncertain track counts as nearer).
+ * the tracker gives a covariance (an uncertain track counts as nearer). Relevance alone could leave out
+ * someone right beside the robot (ten uncertain tracks 3 m away outranked a person 0.3 m away, who then
+ * met neither the hard rows nor C2): everyone within the robot's stopping reach comes first.
  */
 #include "controller_people.h"
 
@@ -36,15 +38,26 @@ static hm_real controller_sigma(const hm_real *c)
     return hm_sqrt(hm_fmax(mean + hm_sqrt(half * half + c[1] * c[1]), HM_R(0.0)));
 }
 
-HM_FUNC void controller_select_people(hm_real path[HM_N + 1][2], const hm_controller_input *cin, hm_input *in,
-                                      hm_controller_output *out)
+/* 1 when track i ranks before track j: everyone within the stopping reach first, nearest first (the hard
+ * distance rows and the monitor's C2 act on them now, whatever their predictions); then the rest by their
+ * relevance to the expected path. */
+static int controller_ranks_before(const int *urgent, const hm_real *now, const hm_real *score, int i, int j)
 {
-    hm_real score[HM_MAX_TRACKS];
-    int chosen[HM_MAX_TRACKS];
+    if (urgent[i] != urgent[j]) return urgent[i];
+    return urgent[i] ? now[i] < now[j] : score[i] < score[j];
+}
+
+HM_FUNC void controller_select_people(hm_real path[HM_N + 1][2], const hm_controller_input *cin, const hm_params *p,
+                                      hm_real v_cap, hm_input *in, hm_controller_output *out)
+{
+    hm_real score[HM_MAX_TRACKS], now[HM_MAX_TRACKS];
+    int urgent[HM_MAX_TRACKS], chosen[HM_MAX_TRACKS];
+    const hm_real a_brake = -p->a_bounds[0];
     int i, n, j, k = 0;
     for (i = 0; i < cin->n_tracks; i++) {
         const hm_real *t = cin->tracks[i];
-        hm_real best = HM_INF;
+        const hm_real ex = t[0] - cin->pose[0], ey = t[1] - cin->pose[1];
+        hm_real best = HM_INF, closing, reach;
         for (n = 0; n <= HM_N; n++) {
             const hm_real tau = HM_R(HM_DT) * (hm_real)n;
             const hm_real dx = t[0] + tau * t[2] - path[n][0];
@@ -53,13 +66,18 @@ HM_FUNC void controller_select_people(hm_real path[HM_N + 1][2], const hm_contro
         }
         score[i] = hm_sqrt(best);
         if (cin->track_has_covariance[i] == 1) score[i] -= HM_R(2.0) * controller_sigma(cin->track_covariances[i]);
+        now[i] = hm_sqrt(ex * ex + ey * ey);
+        /* the speed at which they close in on the robot (none when walking off) */
+        closing = now[i] > HM_R(0.0) ? hm_fmax(-(t[2] * ex + t[3] * ey) / now[i], HM_R(0.0)) : HM_R(0.0);
+        reach = monitor_stopping_reach(p->d_h, p->reaction_time, a_brake, v_cap, closing);
+        urgent[i] = now[i] < reach;
         chosen[i] = 0;
     }
-    /* the HM_NH best, in order of relevance (a partial selection sort: N_h passes over the tracks) */
+    /* the HM_NH first, in order of rank (a partial selection sort: N_h passes over the tracks) */
     for (j = 0; j < HM_NH && j < cin->n_tracks; j++) {
         int pick = -1;
         for (i = 0; i < cin->n_tracks; i++)
-            if (!chosen[i] && (pick < 0 || score[i] < score[pick])) pick = i;
+            if (!chosen[i] && (pick < 0 || controller_ranks_before(urgent, now, score, i, pick))) pick = i;
         chosen[pick] = 1;
         out->people_index[k] = pick;
         out->people_ids[k] = cin->track_ids[pick];

@@ -12,11 +12,12 @@
  * once per period for the two selections below (which only read it). */
 HM_FUNC void controller_expected_path(const hm_solver *s, const hm_controller_input *cin, hm_real path[HM_N + 1][2]);
 
-/* The N_h tracks nearest to the robot's expected path over the horizon (not only now) into the
- * solver's input (in->n_humans, humans_now, humans_pred) and out (people_index, people_ids,
- * predictions). */
-HM_FUNC void controller_select_people(hm_real path[HM_N + 1][2], const hm_controller_input *cin, hm_input *in,
-                                      hm_controller_output *out);
+/* N_h tracks into the solver's input (in->n_humans, humans_now, humans_pred) and out (people_index,
+ * people_ids, predictions): first everyone within the stopping reach of a robot at up to v_cap (m/s) under
+ * p (monitor_stopping_reach), nearest first; then those nearest to the robot's expected path over the
+ * horizon (not only now). */
+HM_FUNC void controller_select_people(hm_real path[HM_N + 1][2], const hm_controller_input *cin, const hm_params *p,
+                                      hm_real v_cap, hm_input *in, hm_controller_output *out);
 
 /* The obstacle point the robot could reach soonest into in->obstacle (in->has_obstacle = 0 without
  * points): the smallest, over the robot's position and the expected path's nodes, of the way there

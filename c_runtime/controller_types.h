@@ -22,4 +22,9 @@ typedef struct HM_NS(controller) {
     HM_REAL time_recovery;
     int has_theta;                /* 1: theta is the last period's heading, unwrapped */
     HM_REAL theta;
+    /* The start of a straight path to a goal pose given alone (the progress objective measures progress
+     * along a line that does not move with the robot): where the robot was when it got that goal. */
+    int has_origin;
+    HM_REAL origin[2];
+    HM_REAL origin_goal[2];
 } HM_NS(controller);

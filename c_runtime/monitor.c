@@ -46,6 +46,12 @@ HM_FUNC int monitor_check_input(const hm_input *in, int check_x0)
     int j;
     if (check_x0 && !monitor_state_ok(in->x0)) return 0;
     if (!monitor_state_ok(in->goal)) return 0;
+    if (in->has_refs != 0 && in->has_refs != 1) return 0;
+    if (in->has_refs) {
+        int n;
+        for (n = 0; n <= HM_N; n++)
+            if (!monitor_state_ok(in->refs[n])) return 0;
+    }
     if (in->n_humans < 0 || in->n_humans > HM_NG - 1) return 0;
     if (in->has_obstacle != 0 && in->has_obstacle != 1) return 0;
     if (in->has_obstacle && !monitor_position_ok(in->obstacle)) return 0;
@@ -82,6 +88,13 @@ static void monitor_separation_reach(hm_real d_h, hm_real t_r, hm_real a_brake, 
 {
     *reach0 = d_h + v_cap * t_r + v_cap * v_cap / (HM_R(2.0) * a_brake);
     *per_speed = t_r + v_cap / a_brake;
+}
+
+HM_FUNC hm_real monitor_stopping_reach(hm_real d_h, hm_real t_r, hm_real a_brake, hm_real v_cap, hm_real speed_h)
+{
+    hm_real reach0, per_speed;
+    monitor_separation_reach(d_h, t_r, a_brake, v_cap, &reach0, &per_speed);
+    return reach0 + speed_h * per_speed;
 }
 
 /* 1 when the person at (dx, dy) from the robot is ahead of its heading: only they bound its speed. */

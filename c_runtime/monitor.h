@@ -61,6 +61,12 @@ HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_rea
                                          const hm_real *vh, hm_real d_h, hm_real t_r, hm_real a_brake,
                                          hm_real v_cap);
 
+/* The stopping reach: how far a person closing in at speed_h (m/s) can be from a robot that moves at up to
+ * v_cap, reacts after t_r and brakes at a_brake > 0, and still come within d_h of it before it stands:
+ * d_h + v_cap t_r + v_cap^2 / (2 a_brake) + speed_h (t_r + v_cap / a_brake). Everyone within it must be
+ * among the people the OCP sees. */
+HM_FUNC hm_real monitor_stopping_reach(hm_real d_h, hm_real t_r, hm_real a_brake, hm_real v_cap, hm_real speed_h);
+
 /* The smallest monitor_separation_speed over the present humans of in, for a robot at x (heading x[2]):
  * each human at node n's prediction (their current position at n = 0), closing at the velocity of
  * their prediction over the interval from node n (the last interval's at n = N). HM_INF when none

@@ -12,6 +12,11 @@ HM_FUNC int ocp_nlp_clamp_humans(const hm_input *in)
     return nh;
 }
 
+HM_FUNC const hm_real *ocp_nlp_goal_at(const hm_input *in, int n)
+{
+    return in->has_refs == 1 ? in->refs[n] : in->goal;
+}
+
 HM_FUNC unsigned long long ocp_nlp_now(const hm_solver *s)
 {
     return s->clock ? s->clock(s->clock_ctx) : 0ULL;

@@ -44,6 +44,8 @@ enum hm_status { HM_STATUS_TABLE(HM_STATUS_ENUM_ROW) };
 
 /* The present humans of the input, their count clamped to 0..HM_NG - 1. */
 HM_FUNC int ocp_nlp_clamp_humans(const hm_input *in);
+/* The goal the cost of node n tracks: in->refs[n] with per-node goals (in->has_refs), else in->goal. */
+HM_FUNC const hm_real *ocp_nlp_goal_at(const hm_input *in, int n);
 
 /* The solver's clock now (0 without a clock). */
 HM_FUNC unsigned long long ocp_nlp_now(const hm_solver *s);

@@ -324,7 +324,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
                 hm_model_dynamics(x, s->u[n], x_next, qp->A[n], qp->B[n]);
                 for (i = 0; i < HM_NX; i++) qp->b[n][i] = x_next[i] - s->x[n + 1][i];
             }
-            hm_model_cost_stage(x, s->u[n], in->goal, p->w_goal, p->w_control, &l, q, qp->r[n], Q, qp->R[n]);
+            hm_model_cost_stage(x, s->u[n], ocp_nlp_goal_at(in, n), p->w_goal, p->w_control, &l, q, qp->r[n], Q, qp->R[n]);
             for (i = 0; i < HM_NU; i++) qp->R[n][i + i * HM_NU] += reg;
             for (i = 0; i < HM_NU * HM_NX; i++) qp->S[n][i] = HM_R(0.0);
             if (exact) {
@@ -339,7 +339,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
             qp->lbu[n][1] = p->omega_bounds[0] - s->u[n][1];
             qp->ubu[n][1] = p->omega_bounds[1] - s->u[n][1];
         } else {
-            hm_model_cost_terminal(x, in->goal, p->w_goal_terminal, &l, q, Q);
+            hm_model_cost_terminal(x, ocp_nlp_goal_at(in, n), p->w_goal_terminal, &l, q, Q);
         }
         for (i = 0; i < HM_NX; i++) Q[i + i * HM_NX] += reg;
         cost += l;

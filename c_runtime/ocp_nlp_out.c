@@ -72,19 +72,29 @@ HM_FUNC void ocp_nlp_report(const hm_solver *s, const hm_input *in, hm_output *o
     out->min_human_distance = ocp_nlp_min_human_distance(s, in);
 }
 
-/* Protective stop: brake to standstill at the configured rate (a_bounds, whenever their row of the
- * parameter table holds, even with another row broken; else the spec's a_bounds), no turning; out's
- * plan shows the braking from the measured state. Without a usable measured state the command is
- * v = 0 and u0 the hardest braking. After a failure (C1, unusable inputs, the command guard, the
- * clock, a state jump) the next step starts cold, exactly as a fresh solver; after a C2 stop the plan
- * is kept, so that the next steps go on improving it (a cold start would put the unsafe straight-line
- * guess back every time). */
+/* The braking control from speed v: towards v = 0 within one interval, at most at the configured rate of
+ * its direction (forward motion brakes at a_min < 0, reverse motion at a_max > 0; the parameter rules keep
+ * both at least BRAKING_MIN). */
+static hm_real ocp_nlp_braking_control(hm_real v, hm_real a_min, hm_real a_max)
+{
+    return hm_fmin(hm_fmax(-v / HM_R(HM_DT), a_min), a_max);
+}
+
+/* Protective stop: brake to standstill at the configured rates (a_bounds, whenever their row of the
+ * parameter table holds, even with another row broken; else the spec's a_bounds), from either direction,
+ * no turning; out's plan shows the braking from the measured state. Without a usable pose the plan's
+ * positions are zeros, but a usable speed is still braked from; without a usable speed the command is
+ * v = 0 and u0 zero (the direction to brake in is unknown: a fixed braking acceleration would speed up a
+ * robot moving the other way). After a failure (C1, unusable inputs, the command guard, the clock, a
+ * state jump) the next step starts cold, exactly as a fresh solver; after a C2 stop the plan is kept, so
+ * that the next steps go on improving it (a cold start would put the unsafe straight-line guess back
+ * every time). */
 HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output *out, int reason)
 {
     hm_params spec_params;
     const hm_params *brake = &s->params;
     hm_real a_min, a_max;
-    int x0_ok, n, i;
+    int x0_ok, v_ok, n, i;
     if (!hm_params_brake_ok(brake)) {
         hm_params_default(&spec_params);
         brake = &spec_params;
@@ -92,15 +102,18 @@ HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output
     a_min = brake->a_bounds[0];
     a_max = brake->a_bounds[1];
     x0_ok = monitor_check_state(in->x0);
+    v_ok = monitor_finite(in->x0[3]) && hm_fabs(in->x0[3]) <= HM_MONITOR_MAX_SPEED;
     out->stop = 1;
     out->stop_reason = reason;
     if (!x0_ok) {
-        /* No trustworthy state (or bounds): full braking, a plan of zeros, nothing computed. */
+        /* No trustworthy pose: a plan of zeros but for the braking speeds, nothing else computed. */
         for (n = 0; n <= HM_N; n++)
             for (i = 0; i < HM_NX; i++) out->x[n][i] = HM_R(0.0);
+        out->x[0][3] = v_ok ? in->x0[3] : HM_R(0.0);
         for (n = 0; n < HM_N; n++) {
-            out->u[n][0] = a_min;
+            out->u[n][0] = v_ok ? ocp_nlp_braking_control(out->x[n][3], a_min, a_max) : HM_R(0.0);
             out->u[n][1] = HM_R(0.0);
+            out->x[n + 1][3] = out->x[n][3] + HM_R(HM_DT) * out->u[n][0];
         }
         out->min_human_distance = HM_INF;
     } else {
@@ -109,7 +122,7 @@ HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output
         int j, humans_ok;
         for (i = 0; i < HM_NX; i++) out->x[0][i] = in->x0[i];
         for (n = 0; n < HM_N; n++) {
-            out->u[n][0] = hm_fmin(hm_fmax(-out->x[n][3] / HM_R(HM_DT), a_min), a_max);
+            out->u[n][0] = ocp_nlp_braking_control(out->x[n][3], a_min, a_max);
             out->u[n][1] = HM_R(0.0);
             hm_model_dynamics(out->x[n], out->u[n], out->x[n + 1], A, B);
         }
@@ -125,7 +138,8 @@ HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output
     }
     out->u0[0] = out->u[0][0];
     out->u0[1] = HM_R(0.0);
-    out->command[0] = x0_ok ? out->x[1][3] : HM_R(0.0);
+    /* a speed braked to zero within the interval is zero, not the model's rounding past it */
+    out->command[0] = v_ok && out->x[1][3] * out->x[0][3] > HM_R(0.0) ? out->x[1][3] : HM_R(0.0);
     out->command[1] = HM_R(0.0);
     s->prepared = 0;
     if (reason != HM_STOP_UNSAFE_PLAN && reason != HM_STOP_HUMAN_TOO_CLOSE && reason != HM_STOP_SEPARATION)

@@ -178,7 +178,11 @@ HM_FUNC int ocp_nlp_sqp_rti_feedback(hm_solver *s, const hm_input *in, hm_output
 /* A whole real-time iteration: the deadline counts from the start of the preparation. */
 HM_FUNC int ocp_nlp_sqp_rti_step(hm_solver *s, const hm_input *in, hm_output *out)
 {
-    const unsigned long long t0 = ocp_nlp_now(s);
+    return ocp_nlp_sqp_rti_step_from(s, in, out, ocp_nlp_now(s));
+}
+
+HM_FUNC int ocp_nlp_sqp_rti_step_from(hm_solver *s, const hm_input *in, hm_output *out, unsigned long long t0)
+{
     ocp_nlp_rti_prepare(s, in);
     return ocp_nlp_rti_feedback_from(s, in, out, t0, 0);
 }

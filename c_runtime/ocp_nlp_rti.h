@@ -14,5 +14,8 @@ HM_FUNC void ocp_nlp_sqp_rti_prepare(hm_solver *s, const hm_input *in);
 HM_FUNC int ocp_nlp_sqp_rti_feedback(hm_solver *s, const hm_input *in, hm_output *out);
 /* prepare + feedback, the deadline counting from the start of the preparation. */
 HM_FUNC int ocp_nlp_sqp_rti_step(hm_solver *s, const hm_input *in, hm_output *out);
+/* The same, the deadline counting from t0 (a clock reading taken before it): a caller that works before
+ * the solver (the controller) spends the same deadline. */
+HM_FUNC int ocp_nlp_sqp_rti_step_from(hm_solver *s, const hm_input *in, hm_output *out, unsigned long long t0);
 
 #endif /* OCP_NLP_RTI_H */

@@ -60,9 +60,9 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
             hm_real gu[HM_NU], hu[HM_NU * HM_NU], x_next[HM_NX], A[HM_NX * HM_NX], B[HM_NX * HM_NU];
             hm_model_dynamics(x, s->u[n], x_next, A, B);
             for (i = 0; i < HM_NX; i++) gaps += hm_fabs(x_next[i] - s->x[n + 1][i]);
-            hm_model_cost_stage(x, s->u[n], in->goal, p->w_goal, p->w_control, &l, gx, gu, hx, hu);
+            hm_model_cost_stage(x, s->u[n], ocp_nlp_goal_at(in, n), p->w_goal, p->w_control, &l, gx, gu, hx, hu);
         } else {
-            hm_model_cost_terminal(x, in->goal, p->w_goal_terminal, &l, gx, hx);
+            hm_model_cost_terminal(x, ocp_nlp_goal_at(in, n), p->w_goal_terminal, &l, gx, hx);
         }
         merit += l;
         /* the people whose potential this node carries: none beyond the potential's horizon */

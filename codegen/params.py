@@ -177,9 +177,10 @@ class Param:
         return row
 
 
-# The weakest braking a protective stop may be configured with [m/s^2]: 1 m/s stopped in at most 10 s. A
-# lower acceleration bound of 0 (or -1e-300) let a stop command a = 0: the robot drove on at its speed
-# with a person ahead (issue 22, item 1). The spec, the C check and Python all apply this row.
+# The weakest braking a protective stop may be configured with [m/s^2]: 1 m/s stopped in at most 10 s, in
+# either direction (forward motion brakes at the lower acceleration bound, reverse motion at the upper). A
+# bound of 0 (or 1e-9) let a stop command no braking: the robot drove on at its speed with a person ahead
+# or behind. The spec, the C check and Python all apply this row.
 BRAKING_MIN = 0.1
 
 # Caps: far beyond any robot, but finite, so that no value overflows the solver's arithmetic.
@@ -210,7 +211,7 @@ PARAMS: tuple[Param, ...] = (
           "exact-penalty weight on the human rows: must exceed their multipliers", valid=_WEIGHT),
     Param("human_slack_l2", "humans.slack_l2", "real", 100.0, "L2 penalty on the human-row slack (0.5*l2*s^2)",
           valid=_WEIGHT),
-    # Speed and separation (issue 23; ISO/TS 15066's protective separation, for people): the paper keeps
+    # Speed and separation (ISO/TS 15066's protective separation, for people): the paper keeps
     # the plan d_h from where people are now; a person walking towards the robot covers a metre while it
     # brakes from 0.8 m/s. Not in the Ipopt reference: the bound is frozen at each linearisation point.
     Param("separation", "humans.separation", "flag", True,
@@ -233,8 +234,9 @@ PARAMS: tuple[Param, ...] = (
           lower=Range(-100.0, 0.0), upper=Range(0.0, 100.0, lo_open=True), problem=True,
           reason="the robot must be able to come to a standstill, and to move"),
     Param("a_bounds", "bounds.a", "interval", (-1.0, 1.0), "acceleration", unit="m/s^2", size=2,
-          lower=Range(-100.0, -BRAKING_MIN), upper=Range(0.0, 100.0, lo_open=True), problem=True,
-          reason="a protective stop must be able to brake, by at least 0.1 m/s^2, and the robot to speed up"),
+          lower=Range(-100.0, -BRAKING_MIN), upper=Range(BRAKING_MIN, 100.0), problem=True,
+          reason="a protective stop must be able to brake from either direction, by at least 0.1 m/s^2 "
+                 "(a reversing robot brakes at the upper bound)"),
     Param("omega_bounds", "bounds.omega", "interval", (-1.5, 1.5), "turn rate", unit="rad/s", size=2,
           lower=Range(-100.0, 0.0), upper=Range(0.0, 100.0), problem=True,
           reason="the robot must be able to hold its heading"),
@@ -265,6 +267,14 @@ PARAMS: tuple[Param, ...] = (
     Param("lookahead", "controller.lookahead", "real", 0.0,
           "carrot distance along the path (0: v_ref * T, the plan's length at cruising speed)", unit="m",
           valid=Range(0.0, 1e4), controller=True, paper=1e4),
+    Param("progress", "controller.progress", "flag", False,
+          "the progress objective: the OCP tracks a goal per node along the path, each where the robot would be "
+          "at the cruising speed (from its speed, within the acceleration bound, braking to arrive at rest), "
+          "weighted by progress_weights, instead of one carrot with a speed to track in any direction (the "
+          "paper's objective; goal_taper and the approach then apply)", controller=True),
+    Param("progress_weights", "controller.progress_weights", "vector", (20.0, 20.0, 0.0, 1.0),
+          "stage weights on x - g_n with the progress objective (g_n: the node's goal along the path)", size=4,
+          valid=_WEIGHT, controller=True),
     Param("goal_taper", "controller.goal_taper", "real", 0.5,
           "the speed to track is at most goal_taper times the distance left to the goal", unit="1/s",
           valid=Range(0.0, 100.0, lo_open=True), controller=True),

@@ -87,6 +87,16 @@ def check_problem_params(params: Mapping[str, Any]) -> dict[str, FloatArray]:
     return out
 
 
+def _per_node_goal(goal: ArrayLike, N: int) -> FloatArray:
+    """(N + 1, NX): a goal (NX,) repeated at every node, or a goal per node as given."""
+    g = np.asarray(goal, dtype=np.float64)
+    if g.shape == (NX,):
+        return np.tile(g, (N + 1, 1))
+    if g.shape != (N + 1, NX):
+        raise ValueError(f"goal must have shape ({NX},) or (N+1, {NX}) = ({N + 1}, {NX}), got {g.shape}")
+    return g
+
+
 @dataclass(frozen=True)
 class ParamLayout:
     """Offsets of one step's inputs and of the runtime parameters in the parameter vector p."""
@@ -99,7 +109,7 @@ class ParamLayout:
         N, NH = self.N, self.NH
         step = (
             ("x0", (NX,)),
-            ("goal", (NX,)),
+            ("goal", (N + 1, NX)),   # a goal per node (one goal: the same at every node)
             ("humans_now", (NH, 2)),
             ("humans_pred", (N + 1, NH, 2)),
             ("human_active", (NH,)),
@@ -138,7 +148,7 @@ class ParamLayout:
             raise ValueError(f"humans_pred must have shape (N+1, k, 2) = ({N + 1}, {k}, 2), got {pred.shape}")
         values: dict[str, FloatArray] = {
             "x0": np.asarray(x0, dtype=np.float64).reshape(NX),
-            "goal": np.asarray(goal, dtype=np.float64).reshape(NX),
+            "goal": _per_node_goal(goal, N),
         }
         hn = np.zeros((NH, 2))
         hn[:k] = now
@@ -297,14 +307,18 @@ class ReferenceNlp:
         S = ca.reshape(w[so:], 1, N)
         HP = ca.reshape(P["humans_pred"], 2 * NH, N + 1)
         x0, hnow, obstacle = P["x0"], P["humans_now"], P["obstacle"]
-        cin = [P["goal"], P["human_active"], P["q"], P["d_th"], P["kappa"]]
+        # the goals node by node (C order: node-major), as the stage functions' columns
+        G = ca.reshape(P["goal"], NX, N + 1)
+        rest = [P["human_active"], P["q"], P["d_th"], P["kappa"]]
+        cin = [G[:, :N], *rest]
+        cin_N = [G[:, N], *rest]
         l1, l2 = P["slack_l1"], P["slack_l2"]
 
         f = (ca.sum2(stage_cost.map(N)(X[:, :N], U, HP[:, :N], *cin, P["w_goal"], P["w_control"]))
-             + terminal_cost(X[:, N], HP[:, N], *cin, P["w_goal_terminal"])
+             + terminal_cost(X[:, N], HP[:, N], *cin_N, P["w_goal_terminal"])
              + ca.sum2(l1 * S + 0.5 * l2 * S**2))
         GXU = stage_grad.map(N)(X[:, :N], U, HP[:, :N], *cin, P["w_goal"], P["w_control"])
-        gX = ca.horzcat(GXU[:NX, :], terminal_grad(X[:, N], HP[:, N], *cin, P["w_goal_terminal"]))
+        gX = ca.horzcat(GXU[:NX, :], terminal_grad(X[:, N], HP[:, N], *cin_N, P["w_goal_terminal"]))
         grad = ca.vertcat(ca.vec(gX), ca.vec(GXU[NX:, :]), ca.vec(l1 + l2 * S))
 
         g_rows = [X[:, 0] - x0, ca.vec(X[:, 1:] - dynamics.map(N)(X[:, :N], U))]
@@ -334,7 +348,7 @@ class ReferenceNlp:
         hess_nz = ca.vertcat(
             ca.vec(stage_hess.map(N)(X[:, :N], U, sigma, LD, MHs, MOs, HP[:, :N], hnow, obstacle, *cin,
                                      P["w_goal"], P["w_control"])),
-            terminal_hess(X[:, N], sigma, MH[:, N - 1], MO[:, N - 1], HP[:, N], hnow, obstacle, *cin,
+            terminal_hess(X[:, N], sigma, MH[:, N - 1], MO[:, N - 1], HP[:, N], hnow, obstacle, *cin_N,
                           P["w_goal_terminal"]),
             ca.vec(ca.repmat(sigma * l2, N, 1)),
         )

@@ -51,6 +51,8 @@ RUNTIME_SOURCES = (
     "controller_common.c",
     "controller_goal.c",
     "controller_people.c",
+    "controller_tracks.c",
+    "controller_safety.c",
     "controller.c",
 )
 

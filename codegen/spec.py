@@ -275,6 +275,8 @@ class Controller:
     v_ref: float = param("controller.v_ref")
     speed_limit: float = param("controller.speed_limit")
     lookahead: float = param("controller.lookahead")
+    progress: bool = param("controller.progress")
+    progress_weights: tuple[float, ...] = param("controller.progress_weights")
     goal_taper: float = param("controller.goal_taper")
     goal_tolerance: float = param("controller.goal_tolerance")
     yaw_goal_tolerance: float = param("controller.yaw_goal_tolerance")

@@ -19,6 +19,10 @@ from .codegen.params import Param
 from .results import ControllerResult, c_array_view, record_dtype
 from .runtime_params import RuntimeParams
 
+# The most tracks one step takes before the nearest max_tracks are kept (a bound on the copy, not on
+# the controller: a tracker reporting more than this is broken).
+MAX_TRACKS_GIVEN = 100_000
+
 
 def _points(what: str, value: ArrayLike | None, columns: int, capacity: int, key: str) -> np.ndarray:
     """value as an (n, columns) float64 array with n <= capacity (an empty one for None)."""
@@ -51,6 +55,7 @@ class Controller:
         self._mem = ffi.new("char[]", self.memsize)
         self._ctl = fn("controller_create")(self._mem)
         self._c_step = fn("controller_step")
+        self._c_set_tracks = fn("controller_set_tracks")
         self._c_reset = fn("controller_reset")
         self._lock = threading.Lock()
         self._params = RuntimeParams(ffi, lib, name, fn("controller_params")(self._ctl), params_table, self._lock)
@@ -99,13 +104,15 @@ class Controller:
         path: (n, 2) waypoints to the goal, and/or goal: (x, y, theta), the final pose (alone: a straight
         path; with a path: its final heading); people: (k, 4) tracks [x, y, vx, vy] [m, m/s] with
         optional ids (k,) (default 0..k-1) and covariances (k, 3) [sxx, sxy, syy] [m^2] (NaN rows: none);
+        more than max_tracks people: the nearest max_tracks are kept (the C's <name>_controller_set_tracks,
+        as in every face) and the result's n_tracks_dropped says how many were left out;
         obstacles: (m, 2) occupied points [m]. All in one world frame.
         """
         pose_a = np.asarray(pose, dtype=np.float64)
         if pose_a.shape != (3,):
             raise ValueError(f"pose must be (x, y, theta), got shape {pose_a.shape}")
         P = _points("path", path, 2, self.max_path_points, "controller.max_path_points")
-        Q = _points("people", people, 4, self.max_tracks, "controller.max_tracks")
+        Q = _points("people", people, 4, MAX_TRACKS_GIVEN, "people given to one step")
         K = _points("obstacles", obstacles, 2, self.max_obstacle_points, "controller.max_obstacle_points")
         k = Q.shape[0]
         if ids is None:
@@ -136,19 +143,30 @@ class Controller:
             c.has_goal = int(goal is not None)
             if goal is not None:
                 self._goal[...] = goal_a
-            c.n_tracks = k
-            self._tracks[:k] = Q
-            self._ids[:k] = id_a
-            if cov is None:
-                self._has_cov[:k] = 0
-            else:
-                given = np.all(np.isfinite(cov), axis=1)
-                self._has_cov[:k] = given
-                self._cov[:k] = np.where(given[:, None], cov, 0.0)
+            self._set_tracks(Q, id_a, cov)
             c.n_obstacles = K.shape[0]
             self._obstacles[: K.shape[0]] = K
             self._c_step(self._ctl, self._in, self._out)
             return ControllerResult(np.ndarray((), self._out_dtype, self._out_buffer[:]))
+
+    def _set_tracks(self, tracks: np.ndarray, ids: np.ndarray, cov: np.ndarray | None) -> None:
+        """The input's tracks through the C (the nearest max_tracks of more); the pose must be set."""
+        ffi, real = self._ffi, f"{self.name}_real"
+        k = tracks.shape[0]
+        t = np.ascontiguousarray(tracks, dtype=self.dtype)
+        i = np.ascontiguousarray(ids, dtype=np.int32)
+        if cov is None:
+            c_ptr, h_ptr = ffi.NULL, ffi.NULL
+        else:
+            given = np.all(np.isfinite(cov), axis=1)
+            c = np.ascontiguousarray(np.where(given[:, None], cov, 0.0), dtype=self.dtype)
+            h = np.ascontiguousarray(given, dtype=np.int32)
+            c_ptr = ffi.cast(f"{real} (*)[3]", ffi.from_buffer(c))
+            h_ptr = ffi.cast("int *", ffi.from_buffer(h))
+        t_ptr = ffi.cast(f"{real} (*)[4]", ffi.from_buffer(t)) if k else ffi.NULL
+        i_ptr = ffi.cast("int *", ffi.from_buffer(i)) if k else ffi.NULL
+        if self._c_set_tracks(self._in, k, t_ptr, i_ptr, c_ptr if k else ffi.NULL, h_ptr if k else ffi.NULL) < 0:
+            raise RuntimeError(f"{self.name}_controller_set_tracks refused {k} tracks")
 
     def __repr__(self) -> str:
         return (f"<humanmpc.Controller {self.name!r} N={self.dims.N} nh={self.dims.nh} tracks<={self.max_tracks} "

@@ -139,6 +139,7 @@ class ControllerResult:
     plan, controls      planned states (N + 1, 4) [x, y, theta, v] and controls (N, 2)
     ocp_goal            the goal the OCP tracked [x, y, theta, v_ref] (the carrot)
     people_ids, people_index, predictions (N + 1, n_people, 2): the tracks the OCP used
+    n_tracks_dropped    people given beyond max_tracks and left out (the farthest)
     obstacle            the obstacle point the OCP kept d_s from, or None
     distance_to_goal [m], time_without_progress [s], min_human_distance [m]
     time_ms, time_solver_ms, time_recovery_ms
@@ -198,6 +199,7 @@ class ControllerResult:
     goal_reached = _field("goal_reached", bool)
     stalled = _field("stalled", bool)
     recovered = _field("recovered", bool)
+    n_tracks_dropped = _field("n_tracks_dropped", int)
     loop_detected = _field("loop_detected", bool)
     status = _field("status", int)
     qp_status = _field("qp_status", int)

@@ -57,6 +57,8 @@ class Solver:
         rt = self.dtype
         self._x0 = c_array_view(ffi, self._in.x0, (4,), rt)
         self._goal = c_array_view(ffi, self._in.goal, (4,), rt)
+        self._refs = c_array_view(ffi, self._in.refs, (N + 1, 4), rt)
+        self._has_refs = False   # what _in.has_refs holds
         self._obstacle = c_array_view(ffi, self._in.obstacle, (2,), rt)
         self._nh, self._nodes = dims.nh, N + 1
         self._counts = (0, False)   # what _in.n_humans, _in.has_obstacle hold (ffi.new zeroes them)
@@ -87,8 +89,9 @@ class Solver:
         if x0a.shape != (4,):
             raise ValueError(f"x0 must have shape (4,) = [px, py, theta, v], got {x0a.shape}")
         ga = np.asarray(goal, dtype=np.float64)
-        if ga.shape != (4,):
-            raise ValueError(f"goal must have shape (4,) = [gx, gy, gtheta, v_ref], got {ga.shape}")
+        if ga.shape not in ((4,), (self._nodes, 4)):
+            raise ValueError(f"goal must have shape (4,) = [gx, gy, gtheta, v_ref], or (N+1, 4) = ({self._nodes}, 4) "
+                             f"for a goal per node, got {ga.shape}")
         if humans_now is None:
             now = np.zeros((0, 2))
         else:
@@ -114,7 +117,15 @@ class Solver:
             self._obstacle[...] = oa
         # whole-view assignments ([...]): a slice index costs numpy as much again as the copy
         self._x0[...] = x0a
-        self._goal[...] = ga
+        per_node = ga.ndim == 2
+        if per_node:
+            self._refs[...] = ga
+            self._goal[...] = ga[-1]
+        else:
+            self._goal[...] = ga
+        if per_node != self._has_refs:
+            self._in.has_refs = int(per_node)
+            self._has_refs = per_node
         self._h_now_first[k][...] = now
         self._h_pred_first[k][...] = pred
         # the counts only when they change: a cffi attribute store costs as much as an array copy
@@ -135,8 +146,10 @@ class Solver:
              humans_pred: ArrayLike | None = None, obstacle: ArrayLike | None = None) -> StepResult:
         """One real-time iteration: preparation around the shifted previous plan, then feedback.
 
-        humans_now: (k, 2) current positions, k <= N_h; humans_pred: (N+1, k, 2) predicted
-        positions at the nodes; obstacle: (2,) closest obstacle point or None.
+        goal: (4,) [gx, gy, gtheta, v_ref] for every node, or (N+1, 4) a goal per node (the progress
+        objective's references along a path); humans_now: (k, 2) current positions, k <= N_h;
+        humans_pred: (N+1, k, 2) predicted positions at the nodes; obstacle: (2,) closest obstacle point
+        or None.
         """
         with self._lock:
             self._load_inputs(x0, goal, humans_now, humans_pred, obstacle)

@@ -18,7 +18,7 @@ EPS = 1e-3  # the documented distance smoothing (codegen/ocp.DIST_EPS); a proble
 @dataclass
 class Scene:
     x0: np.ndarray
-    goal: np.ndarray
+    goal: np.ndarray  # (4,) the goal of every node, or (N+1, 4) a goal per node
     humans_now: np.ndarray  # (k, 2)
     humans_pred: np.ndarray  # (N+1, k, 2)
     obstacle: np.ndarray | None
@@ -74,13 +74,18 @@ def _rk4(x: ca.MX, u: ca.MX, dt: float) -> ca.MX:
     return x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
+def goal_at(goal: np.ndarray, n: int) -> np.ndarray:
+    """The goal node n tracks."""
+    return goal if goal.ndim == 1 else goal[n]
+
+
 def objective(scene: Scene, pr: Params, x: np.ndarray, u: np.ndarray) -> float:
     """The NLP objective at a trajectory (obstacle slack at its smallest feasible value)."""
     total = 0.0
     g = scene.goal
     for n in range(pr.N + 1):
         w = np.array(pr.w_goal_terminal if n == pr.N else pr.w_goal)
-        total += float(np.sum(w * (x[n] - g) ** 2))
+        total += float(np.sum(w * (x[n] - goal_at(g, n)) ** 2))
         if n < pr.N:
             total += float(np.sum(np.array(pr.w_control) * u[n] ** 2))
         for i in range(scene.humans_now.shape[0]):
@@ -108,7 +113,7 @@ def solve_ipopt(scene: Scene, pr: Params, x_init: np.ndarray | None = None, u_in
     for n in range(N + 1):
         w = pr.w_goal_terminal if n == N else pr.w_goal
         for j in range(4):
-            cost += w[j] * (X[j, n] - g[j]) ** 2
+            cost += w[j] * (X[j, n] - goal_at(g, n)[j]) ** 2
         for i in range(k):
             cost += _potential(_dist(X[:2, n], scene.humans_pred[n, i]), pr.q, pr.d_th, pr.kappa)
         if n < N:

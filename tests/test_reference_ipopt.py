@@ -104,6 +104,19 @@ def test_objective_equals_the_independent_formulation() -> None:
         assert ours == pytest.approx(theirs, rel=1e-12)
 
 
+def test_objective_with_a_goal_per_node_equals_the_independent_formulation() -> None:
+    spec = resolve_spec({"preset": "paper", "humans": {"max": 3}, "horizon": {"N": 8, "T": 0.8}})
+    nlp = ReferenceNlp(spec)
+    pr = indep_params(spec)
+    rng = np.random.default_rng(6)
+    scene = random_scene(rng, nlp.N, 2)
+    scene["goal"] = rng.normal(size=(nlp.N + 1, 4))
+    p = nlp.params.pack(**scene, params=problem_params(spec))
+    X = rng.normal(scale=0.7, size=(nlp.N + 1, 4))
+    U = rng.normal(size=(nlp.N, 2))
+    assert float(nlp.plan_cost(X, U, p)) == pytest.approx(indep.objective(indep.Scene(**scene), pr, X, U), rel=1e-12)
+
+
 def test_bounds_switch_rows_off_for_absent_humans_and_obstacle() -> None:
     spec = resolve_spec({"preset": "paper", "humans": {"max": 3}, "horizon": {"N": 4, "T": 0.4}})
     nlp = ReferenceNlp(spec)

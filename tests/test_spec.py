@@ -168,7 +168,7 @@ def test_spec_built_in_code_is_validated_again_before_generation(tmp_path: Path)
     t=st.floats(0.1, 30.0),
     w=st.lists(st.floats(0.0, 1e3), min_size=4, max_size=4),
     lo=st.floats(-3.0, -0.1),  # a protective stop must be able to brake: the lower bound is <= -0.1
-    width=st.floats(0.01, 5.0),
+    width=st.floats(0.1, 5.0),  # the upper bound too: a reversing robot brakes at it
 )
 def test_valid_specs_resolve_to_what_was_written(n: int, nh: int, t: float, w: list[float], lo: float,
                                                  width: float) -> None:

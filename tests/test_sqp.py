@@ -100,6 +100,50 @@ def test_with_no_human_near_the_path_both_reach_the_same_optimum_from_a_cold_sta
     assert np.max(np.abs(ref.x - ours.x)) <= 1e-3
 
 
+def references_along(scene: Scene, speed: float, weave: float) -> np.ndarray:
+    """(N+1, 4) goals per node, the progress objective's kind: points along a weaving line from the start
+    towards the scene's goal at the given speed, heading along it, that speed to track."""
+    t = 0.1 * np.arange(51)
+    heading = float(np.arctan2(scene.goal[1], scene.goal[0]))
+    along = speed * t
+    refs = np.zeros((51, 4))
+    refs[:, 0] = along * np.cos(heading) - weave * np.sin(t) * np.sin(heading)
+    refs[:, 1] = along * np.sin(heading) + weave * np.sin(t) * np.cos(heading)
+    refs[:, 2] = heading
+    refs[:, 3] = speed
+    return refs
+
+
+@pytest.mark.parametrize(("seed", "k"), [(0, 0), (1, 5), (2, 12), (3, 30)])
+def test_full_sqp_with_a_goal_per_node_reaches_an_optimum_ipopt_cannot_improve(crowd30: humanmpc.Solver, seed: int,
+                                                                               k: int) -> None:
+    """Per-node goals (the progress objective's references along a path): the full SQP against CasADi's Ipopt
+    on the independent formulation of tests/nlp_reference.py."""
+    rng = np.random.default_rng(3000 + seed)
+    scene = random_scene(rng, k)
+    scene.goal = references_along(scene, rng.uniform(0.4, 1.0), rng.uniform(0.0, 1.0))
+    ours = solve_ours(crowd30, scene)
+    assert ours.status_name == "solved", f"SQP did not converge: {ours.status_name}, kkt {ours.kkt:.2e}"
+    pr = Params()
+    our_cost = objective(scene, pr, ours.x, ours.u)
+    assert our_cost == pytest.approx(ours.cost, rel=1e-9)
+    ref = solve_ipopt(scene, pr, x_init=ours.x, u_init=ours.u)
+    assert ref.success, f"Ipopt failed from our solution: {ref.stats.get('return_status')}"
+    assert ref.cost >= our_cost - 1e-6 * abs(our_cost), f"Ipopt found a lower cost: {ref.cost} < {our_cost}"
+    assert np.max(np.abs(ref.x - ours.x)) <= 1e-3
+
+
+def test_the_same_goal_at_every_node_is_bit_for_bit_one_goal(paper: humanmpc.Solver) -> None:
+    scene = random_scene(np.random.default_rng(7), 5)
+    paper.reset()
+    one = [paper.step(scene.x0, scene.goal, scene.humans_now, scene.humans_pred, scene.obstacle) for _ in range(3)]
+    paper.reset()
+    per_node = np.tile(scene.goal, (51, 1))
+    many = [paper.step(scene.x0, per_node, scene.humans_now, scene.humans_pred, scene.obstacle) for _ in range(3)]
+    for a, b in zip(one, many, strict=True):
+        assert np.array_equal(a.x, b.x) and np.array_equal(a.u, b.u) and a.cost == b.cost
+
+
 def tapered_goal(goal: np.ndarray, x: np.ndarray) -> np.ndarray:
     """v_ref falls off near the goal (as a planner's goal checker does), so the robot stops there."""
     g = goal.copy()

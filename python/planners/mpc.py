@@ -103,14 +103,11 @@ class MPCPlanner:
             ctl.set_params(v_ref=float(obs.goal[3]), speed_limit=float(obs.goal[3]))
         if self._sensor is None or self._sensor.world is not obs.world:
             self._sensor = ObstacleSensor(obs.world, max_points=ctl.max_obstacle_points)
-        people = obs.humans_now
-        if people.shape[0] > ctl.max_tracks:  # more people than the tracker reports: the nearest
-            keep = np.argsort(np.linalg.norm(people - obs.x[:2], axis=1))[: ctl.max_tracks]
-        else:
-            keep = np.arange(people.shape[0])
-        tracks = np.hstack([people[keep], obs.humans_velocity[keep]])
+        # every person as a track; more than the controller holds: the C keeps the nearest
+        tracks = np.hstack([obs.humans_now, obs.humans_velocity])
         r = ctl.step(obs.time, pose=obs.x[:3], v=float(obs.x[3]), omega=self._omega, path=self._path(obs),
-                     goal=obs.goal[:3], people=tracks, ids=keep, obstacles=self._sensor.points(obs.x[:2]))
+                     goal=obs.goal[:3], people=tracks, ids=np.arange(tracks.shape[0]),
+                     obstacles=self._sensor.points(obs.x[:2]))
         self.last = r
         self._omega = float(r.command[1])
         self.recoveries += int(r.recovered)

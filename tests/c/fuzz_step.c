@@ -17,7 +17,8 @@
  *   - without a stop: the command (v, omega) and u0 (a, omega) are within the bounds in force
  *     (to the command guard's tolerance);
  *   - with a stop: it brakes: no turning, the speed commanded between 0 and the measured one, at the
- *     configured deceleration (a_bounds, whenever their rule holds, else the spec's);
+ *     configured rate of its direction (a_bounds[0] forward, a_bounds[1] backward, whenever their rule
+ *     holds, else the spec's), a pose or not; without a usable speed, v = 0 and no acceleration;
  *   - whatever was bad is a stop with its reason: broken parameters (invalid_params), an input the
  *     harness made non-finite or absurd (invalid_input or invalid_params), a clock that stood still
  *     or ran backwards over a solved QP (a stop).
@@ -230,11 +231,13 @@ static void check(int bad, int clock_bad)
             fail("a command outside the bounds without a stop");
     } else {
         const S(real) *a = S(params_check)(p) == 0 || (p->a_bounds[0] <= -0.1 && p->a_bounds[0] >= -100.0 &&
-                                                     p->a_bounds[1] > 0.0 && p->a_bounds[1] <= 100.0)
+                                                     p->a_bounds[1] >= 0.1 && p->a_bounds[1] <= 100.0)
                                ? p->a_bounds
                                : spec.a_bounds;
+        const int v_ok = isfinite((double)in.x0[3]) && fabs((double)in.x0[3]) <= 100.0;
         if (out.u0[1] != 0 || out.command[1] != 0) fail("a stop that turns");
-        if (state_ok(in.x0)) {
+        if (state_ok(in.x0) || v_ok) {
+            /* a speed to brake from (with or without a usable pose): towards 0, at the rate of its direction */
             const double v0 = (double)in.x0[3], dt = U(DT);
             const double expect = fmin(fmax(-v0 / dt, (double)a[0]), (double)a[1]);
             if (fabs((double)out.u0[0] - expect) > 1e-9 * (1.0 + fabs(expect)))
@@ -242,8 +245,8 @@ static void check(int bad, int clock_bad)
             if (v0 >= 0 ? !((double)out.command[0] >= -1e-9 && (double)out.command[0] <= v0 + 1e-9)
                         : !((double)out.command[0] <= 1e-9 && (double)out.command[0] >= v0 - 1e-9))
                 fail("a stop whose speed does not come down");
-        } else if (out.command[0] != 0 || !(out.u0[0] < 0)) {
-            fail("a stop without a state that does not command standstill");
+        } else if (out.command[0] != 0 || out.u0[0] != 0) {
+            fail("a stop without a speed that does not command standstill with no acceleration");
         }
     }
 }
