@@ -241,7 +241,8 @@ def test_node_refuses_a_parameter_that_breaks_its_rule(workspace: tuple[Path, st
     ("transform_timeout: 0.05", "parameter ~transform_timeout must be a number with 0 <= transform_timeout <= 1 "
                                 "and transform_timeout <= 0.25 * control_period [s], got 0.05 with control_period "
                                 "0.1"),
-    ("odom_timeout: 1.0e+9", "parameter ~odom_timeout must be a number with 0 < odom_timeout <= 10 [s], got 1000000000.0"),
+    ("odom_timeout: 1.0e+9", "parameter ~odom_timeout must be a number with 0 < odom_timeout <= 10 [s], got "
+                             "1000000000.0"),
     ("people_timeout: soon", "parameter ~people_timeout must be a number with 0 < people_timeout <= 10 [s], got "
                              "'soon' (a string) (not a number)"),
     ("control_period: 0", "parameter ~control_period must be a number with 0 < control_period <= 1 [s], got 0"),
