@@ -24,7 +24,7 @@ from typing import Any
 from . import __version__
 from .build import BuildError, read_manifest
 from .generate import GenerateError, write_atomically
-from .params import PARAMS, spec_params
+from .params import PARAMS, Range, spec_params
 from .render import _c_string, c_float, c_identifier, make_environment
 from .spec import Spec, SpecError, load_spec
 from .status import status_tables
@@ -47,15 +47,73 @@ class NodeStopReason:
     message: str
 
 
-# The node's own stop reasons: what the controller cannot see. The order is the node's priority.
+# The node's own stop reasons: what the controller cannot see (the age, the stamps and the frames of its
+# inputs, and a message beyond the node's buffers).
 NODE_STOP_REASONS = (
     NodeStopReason("STOP_STALE_ODOMETRY", 100, "stale_odometry",
-                   "protective stop (node): no odometry within odom_timeout"),
+                   "protective stop (node): no odometry stamped within odom_timeout"),
     NodeStopReason("STOP_STALE_PEOPLE", 101, "stale_people",
-                   "protective stop (node): no tracked people within people_timeout"),
+                   "protective stop (node): no tracked people stamped within people_timeout"),
     NodeStopReason("STOP_NO_TRANSFORM", 102, "no_transform",
                    "protective stop (node): no tf2 transform of the path, goal, people or scan into the "
                    "odometry frame"),
+    NodeStopReason("STOP_STALE_SCAN", 103, "stale_scan",
+                   "protective stop (node): the last scan is stamped more than scan_timeout ago"),
+    NodeStopReason("STOP_FUTURE_STAMP", 104, "future_stamp",
+                   "protective stop (node): an input is stamped more than stamp_tolerance ahead of the node's "
+                   "clock (clocks out of step)"),
+    NodeStopReason("STOP_TOO_MANY_TRACKS", 105, "too_many_tracks",
+                   "protective stop (node): a people message holds more tracks than the node's buffer"),
+)
+
+# The most tracks one people message may hold (the node's buffer; the controller keeps the nearest
+# max_tracks of them). More is not a crowd but a broken tracker: a protective stop, too_many_tracks.
+NODE_MAX_TRACKS = 1024
+
+
+@dataclass(frozen=True)
+class NodeParam:
+    """A private parameter of the node's own (docs/ros.md), checked at start like the controller's."""
+
+    name: str
+    kind: str                  # "real" or "flag"
+    default: float | bool | None  # None: the spec's control period
+    doc: str
+    unit: str = ""
+    valid: Range | None = None
+    period_share: float = 0.0  # > 0: also at most this share of control_period
+
+    @property
+    def rule(self) -> str:
+        if self.kind == "flag":
+            return "true or false"
+        assert self.valid is not None
+        text = f"a number with {self.valid.text(self.name)}"
+        if self.period_share:
+            text += f" and {self.name} <= {self.period_share:g} * control_period"
+        return text
+
+
+_TIMEOUT = Range(0.0, 10.0, lo_open=True)
+
+# Checked in this order: control_period first, since a rule below depends on it.
+NODE_PARAMS = (
+    NodeParam("control_period", "real", None, "the timer; by default the spec's T / N", "s",
+              Range(0.0, 1.0, lo_open=True)),
+    NodeParam("odom_timeout", "real", 0.5, "odometry stamped longer ago: protective stop stale_odometry", "s",
+              _TIMEOUT),
+    NodeParam("people_timeout", "real", 0.5, "tracked people stamped longer ago: protective stop stale_people", "s",
+              _TIMEOUT),
+    NodeParam("require_people", "flag", True,
+              "false: run without a people tracker until its first message (then as true)"),
+    NodeParam("scan_timeout", "real", 0.5, "a scan stamped longer ago: protective stop stale_scan", "s", _TIMEOUT),
+    NodeParam("require_scan", "flag", False, "true: no scan yet is a protective stop stale_scan too"),
+    NodeParam("stamp_tolerance", "real", 0.05,
+              "an input stamped further ahead of the node's clock: protective stop future_stamp", "s",
+              Range(0.0, 1.0)),
+    NodeParam("transform_timeout", "real", 0.0,
+              "how long a tf2 lookup waits for the transform at a message's stamp (else the latest is used); "
+              "up to three lookups a period, each delays the command", "s", Range(0.0, 1.0), period_share=0.25),
 )
 
 
@@ -101,9 +159,28 @@ def ros_context(spec: Spec) -> dict[str, Any]:
             "size": p.size,
             "yaml": _yaml_value(values[p.name], p.ctype),
             "doc": _c_string(f"{p.described}; must be {p.rule}"),
+            "kind": p.kind if p.ctype == "int" else "real",
+            "rule": _c_string(f"{p.name} must be {p.rule}"),
         }
         for p in PARAMS
     ]
+    node_params = []
+    for q in NODE_PARAMS:
+        default = spec.dt if q.default is None else q.default
+        row: dict[str, Any] = {
+            "c_name": c_identifier(q.name),
+            "kind": q.kind,
+            "rule": _c_string(f"{q.name} must be {q.rule}" + (f" [{q.unit}]" if q.unit else "")),
+            "doc": _c_string(f"[{q.unit}] {q.doc}" if q.unit else q.doc),
+        }
+        if q.kind == "flag":
+            row.update(yaml="true" if default else "false", cpp="true" if default else "false")
+        else:
+            assert q.valid is not None
+            row.update(yaml=yaml_float(float(default)), cpp=c_float(float(default)),
+                       lo=c_float(q.valid.lo), hi=c_float(q.valid.hi), lo_open=q.valid.lo_open,
+                       hi_open=q.valid.hi_open, period_share=c_float(q.period_share), share=q.period_share > 0)
+        node_params.append(row)
 
     def rows(key: str) -> list[dict[str, Any]]:
         return [{"value": int(r.value), "name": c_identifier(r.name), "message": _c_string(r.message)}
@@ -121,6 +198,8 @@ def ros_context(spec: Spec) -> dict[str, Any]:
         "NK": int(spec.controller.max_obstacle_points),
         "dt": c_float(spec.dt),
         "params": params,
+        "node_params": node_params,
+        "node_max_tracks": NODE_MAX_TRACKS,
         "stop_reasons": rows("stop_reason"),
         "outcomes": rows("outcome"),
         "node_reasons": [{"id": c_identifier(r.id), "value": int(r.value), "name": c_identifier(r.name),

@@ -10,10 +10,14 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
+import socket
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 from xml.etree import ElementTree
 
 import pytest
@@ -22,7 +26,7 @@ import yaml
 from humanmpc.cli import main as cli_main
 from humanmpc.codegen.generate import GenerateError
 from humanmpc.codegen.params import PARAMS
-from humanmpc.codegen.ros import MSGS_PACKAGE, NODE_STOP_REASONS, ROS_MARKER, write_ros
+from humanmpc.codegen.ros import MSGS_PACKAGE, NODE_MAX_TRACKS, NODE_STOP_REASONS, ROS_MARKER, write_ros
 from humanmpc.codegen.status import status_tables
 from tests.conftest import REPO_ROOT, make_solver, require_tool
 
@@ -162,20 +166,231 @@ def test_node_builds_with_debians_catkin_without_warnings(workspace: tuple[Path,
     assert warnings == []
 
 
-def test_node_refuses_a_parameter_that_breaks_its_rule(workspace: tuple[Path, str], tmp_path: Path) -> None:
+@pytest.fixture(scope="module")
+def master(workspace: tuple[Path, str], tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, str]]:
+    """A roscore of this module's own, on a free port (other runs on the machine keep theirs)."""
     ws, _ = workspace
-    env = _ros_env(ws, tmp_path)
-    env["ROS_MASTER_URI"] = "http://127.0.0.1:11399"
-    master = subprocess.Popen(["/usr/bin/roscore", "-p", "11399"], env=env, stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL)
+    env = _ros_env(ws, tmp_path_factory.mktemp("ros_master_home"))
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    env["ROS_MASTER_URI"] = f"http://127.0.0.1:{port}"
+    proc = subprocess.Popen(["/usr/bin/roscore", "-p", str(port)], env=env, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
     try:
-        r = subprocess.run([str(ws / "devel" / "lib" / "paper_ros" / "paper_node"), "_d_h:=-1.0"], env=env,
-                           capture_output=True, text=True, timeout=60)
+        deadline = time.monotonic() + 60
+        while subprocess.run(["/usr/bin/rosparam", "list"], env=env, capture_output=True,
+                             timeout=60).returncode != 0:
+            assert time.monotonic() < deadline, "roscore did not answer within 60 s"
+            time.sleep(0.5)
+        yield env
     finally:
-        master.terminate()
-        master.wait(timeout=30)
-    assert r.returncode == 1
-    assert "parameter ~d_h must be a number with" in r.stdout + r.stderr
+        proc.terminate()
+        proc.wait(timeout=30)
+
+
+NODE_NS = "/paper_controller"
+
+
+def _set_params(env: dict[str, str], yaml_text: str, tmp_path: Path) -> None:
+    """The node's private parameters (none before), loaded from YAML as the launch file's rosparam load does."""
+    subprocess.run(["/usr/bin/rosparam", "delete", NODE_NS], env=env, capture_output=True, timeout=60)
+    if yaml_text:
+        f = tmp_path / "params.yaml"
+        f.write_text(yaml_text)
+        r = subprocess.run(["/usr/bin/rosparam", "load", str(f), NODE_NS], env=env, capture_output=True,
+                           text=True, timeout=60)
+        assert r.returncode == 0, r.stderr
+
+
+def _run_node_to_exit(ws: Path, env: dict[str, str], args: list[str] | None = None) -> str:
+    """The node's output when it exits 1 within 30 s, as a refused parameter must make it."""
+    try:
+        r = subprocess.run([str(ws / "devel" / "lib" / "paper_ros" / "paper_node"), *(args or [])], env=env,
+                           capture_output=True, text=True, timeout=30)
+    except subprocess.TimeoutExpired as err:
+        pytest.fail(f"the node ran on instead of refusing its parameters: {err.stdout!r}")
+    assert r.returncode == 1, r.stdout + r.stderr
+    return r.stdout + r.stderr
+
+
+def test_node_refuses_a_parameter_that_breaks_its_rule(workspace: tuple[Path, str], master: dict[str, str],
+                                                      tmp_path: Path) -> None:
+    ws, _ = workspace
+    _set_params(master, "", tmp_path)
+    out = _run_node_to_exit(ws, master, ["_d_h:=-1.0"])
+    assert "parameter ~d_h must be a number with 0 <= d_h <= 100, got -1" in out
+
+
+@pytest.mark.parametrize(("yaml_text", "message"), [
+    # an integer or a flag given as a real was truncated: 0.5 turned the speed-and-separation check off
+    ("separation: 0.5", "parameter ~separation must be 0 or 1 (false or true), got 0.5 (a real number where an "
+                        "integer is required)"),
+    ("qp_max_iter: 50.0", "parameter ~qp_max_iter must be an integer with 1 <= qp_max_iter <= 1000, got 50.0 (a "
+                          "real number where an integer is required)"),
+    ("approach: yes please", "parameter ~approach must be 0 or 1 (false or true), got 'yes please' (a string)"),
+    ("v_bounds: [0.0, .nan]", "parameter ~v_bounds must be [lower, upper] with"),
+    ("w_goal: [1, 1, 1]", "parameter ~w_goal must be 4 numbers, each with 0 <= w <= 1e+09, got [1, 1, 1] "
+                          "(not a list of 4)"),
+    ("d_h: true", "parameter ~d_h must be a number with 0 <= d_h <= 100, got true (not a number)"),
+    # an infinite time-out threw from ros::Duration in the timer; a large one blocked the timer
+    ("transform_timeout: .inf", "parameter ~transform_timeout must be a number with 0 <= transform_timeout <= 1 "
+                                "and transform_timeout <= 0.25 * control_period [s], got inf (not finite)"),
+    ("transform_timeout: 1000000.0", "parameter ~transform_timeout must be a number with 0 <= transform_timeout <= 1"
+                                     " and transform_timeout <= 0.25 * control_period [s], got 1000000.0"),
+    ("transform_timeout: 0.05", "parameter ~transform_timeout must be a number with 0 <= transform_timeout <= 1 "
+                                "and transform_timeout <= 0.25 * control_period [s], got 0.05 with control_period "
+                                "0.1"),
+    ("odom_timeout: 1.0e+9", "parameter ~odom_timeout must be a number with 0 < odom_timeout <= 10 [s], got "
+                             "1000000000.0"),
+    ("people_timeout: soon", "parameter ~people_timeout must be a number with 0 < people_timeout <= 10 [s], got "
+                             "'soon' (a string) (not a number)"),
+    ("control_period: 0", "parameter ~control_period must be a number with 0 < control_period <= 1 [s], got 0"),
+    ("require_people: 0.5", "parameter ~require_people must be true or false, got 0.5 (a real number where an "
+                            "integer is required)"),
+    ("stamp_tolerance: -0.1", "parameter ~stamp_tolerance must be a number with 0 <= stamp_tolerance <= 1 [s], got "
+                              "-0.10000000000000001"),
+])
+def test_node_refuses_a_parameter_of_the_wrong_type_or_range_naming_it_its_value_and_rule(
+        workspace: tuple[Path, str], master: dict[str, str], tmp_path: Path, yaml_text: str, message: str) -> None:
+    ws, _ = workspace
+    _set_params(master, yaml_text, tmp_path)
+    out = _run_node_to_exit(ws, master)
+    assert message in out, out
+
+
+def _probe(ws: Path, env: dict[str, str], tmp_path: Path, config: dict[str, Any],
+           params: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Starts the node with params, runs tests/ros/node_probe.py with config against it, returns its report."""
+    _set_params(env, yaml.safe_dump(params) if params else "", tmp_path)
+    log = (tmp_path / "node.log").open("w")
+    node = subprocess.Popen([str(ws / "devel" / "lib" / "paper_ros" / "paper_node")], env=env, stdout=log,
+                            stderr=subprocess.STDOUT)
+    try:
+        r = subprocess.run(["/usr/bin/python3", str(ROS_DIR / "node_probe.py"), json.dumps(config)], env=env,
+                           capture_output=True, text=True, timeout=120)
+        assert node.poll() is None, (tmp_path / "node.log").read_text()
+        assert r.returncode == 0, r.stderr[-4000:]
+    finally:
+        node.send_signal(signal.SIGINT)
+        try:
+            node.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            node.kill()
+            node.wait(timeout=30)
+        log.close()
+    report: dict[str, Any] = json.loads(r.stdout.strip().splitlines()[-1])
+    return report
+
+
+def _reasons(report: dict[str, Any], after: float, before: float = 1e9) -> set[str]:
+    """The stop reasons the diagnostics reported between two times since the probe's start."""
+    diags = [d for d in report["diags"] if after < d["t"] < before]
+    assert diags, f"no diagnostics between {after} and {before} s"
+    return {d["stop_reason"] for d in diags}
+
+
+def _last(report: dict[str, Any]) -> dict[str, Any]:
+    assert report["diags"], "no diagnostics"
+    last: dict[str, Any] = report["diags"][-1]
+    return last
+
+
+FAR = [[6.0 + 0.1 * i, 4.0, 0.0, 0.0, 100 + i] for i in range(3)]  # tracked people well away from the robot
+
+
+def test_node_judges_odometry_by_its_stamp_and_refuses_stamps_from_the_future(
+        workspace: tuple[Path, str], master: dict[str, str], tmp_path: Path) -> None:
+    ws, _ = workspace
+    # arriving fresh at 20 Hz, stamped 1 s ago: stale (the arrival time had made it fresh)
+    old = _probe(ws, master, tmp_path, {"odom_offset": -1.0, "tracks": FAR})
+    assert _reasons(old, 1.0) == {"stale_odometry"}
+    assert 0.9 < float(_last(old)["odom_age_s"]) < 1.5
+    future = _probe(ws, master, tmp_path, {"odom_offset": 1.0, "tracks": FAR})
+    assert _reasons(future, 1.0) == {"future_stamp"}
+    people_future = _probe(ws, master, tmp_path, {"people_offset": 1.0, "tracks": FAR})
+    assert _reasons(people_future, 1.0) == {"future_stamp"}
+
+
+def test_node_judges_people_by_their_stamp(workspace: tuple[Path, str], master: dict[str, str],
+                                           tmp_path: Path) -> None:
+    ws, _ = workspace
+    report = _probe(ws, master, tmp_path, {"people_offset": -1.0, "tracks": FAR})
+    assert _reasons(report, 1.0) == {"stale_people"}
+    assert 0.9 < float(_last(report)["people_age_s"]) < 1.5
+
+
+def test_without_require_people_stale_people_stop_the_robot_instead_of_being_used_forever(
+        workspace: tuple[Path, str], master: dict[str, str], tmp_path: Path) -> None:
+    ws, _ = workspace
+    # no people message ever: the node runs without people
+    never = _probe(ws, master, tmp_path, {"people_until": 0.0, "duration": 2.0}, {"require_people": False})
+    assert _reasons(never, 0.5) == {"none"}
+    assert _last(never)["people_age_s"] == "none"
+    # people for 1 s, then none: once people_timeout (0.5 s) has passed, a stop with its reason
+    gone = _probe(ws, master, tmp_path, {"people_until": 1.0, "tracks": FAR}, {"require_people": False})
+    assert _reasons(gone, 0.3, 0.9) == {"none"}
+    assert _reasons(gone, 1.8) == {"stale_people"}
+
+
+def test_a_stale_scan_is_a_protective_stop_reported_with_its_age(workspace: tuple[Path, str],
+                                                                 master: dict[str, str], tmp_path: Path) -> None:
+    ws, _ = workspace
+    report = _probe(ws, master, tmp_path, {"scan": True, "scan_until": 1.0, "tracks": FAR})
+    assert _reasons(report, 0.3, 0.9) == {"none"}
+    assert _reasons(report, 1.8) == {"stale_scan"}
+    assert float(_last(report)["scan_age_s"]) > 1.5
+
+
+def _max_tracks(ws: Path) -> int:
+    spec = yaml.safe_load((ws / "src" / "paper_ros_src" / "paper_ros" / "solver" / "spec.yaml").read_text())
+    n = int(spec["controller"]["max_tracks"])
+    assert n >= 2
+    return n
+
+
+def test_a_non_finite_track_among_more_than_max_tracks_stops_the_robot_as_invalid_input(
+        workspace: tuple[Path, str], master: dict[str, str], tmp_path: Path) -> None:
+    ws, _ = workspace
+    m = _max_tracks(ws)
+    crowd = [[5.0 + 0.1 * i, -4.0, 0.0, 0.0, i] for i in range(m + 8)]
+    for where in (0, m // 2, m + 7):  # wherever it is in the message
+        tracks = [list(t) for t in crowd]
+        tracks[where][0] = "nan"
+        report = _probe(ws, master, tmp_path, {"tracks": tracks, "duration": 1.5})
+        assert _reasons(report, 0.5) == {"invalid_input"}, where
+
+
+def test_more_tracks_than_max_tracks_keep_the_nearest_and_report_the_dropped(
+        workspace: tuple[Path, str], master: dict[str, str], tmp_path: Path) -> None:
+    ws, _ = workspace
+    m = _max_tracks(ws)
+    tracks = [[5.0 + 0.1 * i, -4.0, 0.0, 0.0, i] for i in range(m + 7)] + [[0.3, 0.0, 0.0, 0.0, 999]]
+    report = _probe(ws, master, tmp_path, {"tracks": tracks, "goal": [8.0, 0.0], "duration": 1.5})
+    last = _last(report)
+    assert (last["tracks_received"], last["tracks"], last["tracks_dropped"]) == (str(m + 8), str(m), "8")
+    assert _reasons(report, 0.5) == {"human_too_close"}  # the person 0.3 m away is among the kept
+
+
+def test_a_people_message_beyond_the_node_buffer_is_a_protective_stop(
+        workspace: tuple[Path, str], master: dict[str, str], tmp_path: Path) -> None:
+    ws, _ = workspace
+    tracks = [[5.0 + 0.01 * i, 4.0, 0.0, 0.0, i] for i in range(NODE_MAX_TRACKS + 1)]
+    report = _probe(ws, master, tmp_path, {"tracks": tracks, "duration": 1.5})
+    assert _reasons(report, 0.5) == {"too_many_tracks"}
+
+
+def test_track_ids_that_share_their_low_31_bits_or_repeat_stay_distinct(
+        workspace: tuple[Path, str], master: dict[str, str], tmp_path: Path) -> None:
+    ws, _ = workspace
+    tracks = [[3.0, 1.0, 0.0, 0.0, 5], [3.0, -1.0, 0.0, 0.0, 5 + 2**31],  # the same low 31 bits
+              [4.0, 2.0, 0.0, 0.0, 7], [4.0, -2.0, 0.0, 0.0, 7]]            # the same id twice
+    report = _probe(ws, master, tmp_path, {"tracks": tracks, "goal": [8.0, 0.0], "duration": 2.0})
+    ids = report["prediction_ids"]
+    assert len(ids) == 4 and len(set(ids)) == 4, ids
+    assert {5, 7} <= set(ids)  # the tracker's id where it is free
+    assert all(0 <= i < 2**31 for i in ids)
+    assert _last(report)["duplicate_track_ids"] == "1"
 
 
 @pytest.mark.slow
