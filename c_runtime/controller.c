@@ -57,6 +57,8 @@
 /* Slower than this a robot counts as standing: it may turn in place at its goal (the evaluation's threshold
  * of moving, python/eval/metrics.py). */
 #define CONTROLLER_AT_REST HM_R(0.05)
+/* Slower than this a person counts as standing [m/s]. */
+#define CONTROLLER_STANDING HM_R(0.2)
 
 /* 1 when every input is usable: counts within their capacities, numbers finite and not absurd. */
 static int controller_input_ok(const hm_controller_input *cin)
@@ -123,6 +125,17 @@ HM_FUNC void controller_init(hm_controller *c, const hm_params *params)
     controller_reset(c);
 }
 
+/* The end of the collision potential near the goal: the robot's earliest arrival within goal_tolerance from
+ * rest (at v_ref or the speed cap, whichever is lower, reached at the upper acceleration bound) plus
+ * arrival_margin, or the caller's collision_horizon when that is sooner. */
+static hm_real controller_arrival(const hm_params *p, const hm_params *sp, const hm_controller_goal *g)
+{
+    const hm_real v_arrive = hm_fmin(p->v_ref, sp->v_bounds[1]);
+    const hm_real arrival = hm_fmax(g->left - p->goal_tolerance, HM_R(0.0)) / v_arrive +
+                            v_arrive / (HM_R(2.0) * p->a_bounds[1]) + p->arrival_margin;
+    return hm_fmin(p->collision_horizon, arrival);
+}
+
 /* The solver's parameters for this period: the caller's, with the speed limit and, within the
  * horizon's reach of the goal, the approach weights and the collision potential's end. Sets the goal's
  * speed (in->goal[3]). */
@@ -132,14 +145,15 @@ static void controller_solver_params(hm_controller *c, const hm_controller_goal 
     hm_params *sp = &c->solver.params;
     const hm_real horizon = HM_R(HM_DT) * (hm_real)HM_N;
     const hm_real cap = hm_fmin(p->v_bounds[1], p->speed_limit);
-    hm_real v_arrive, arrival;
     *sp = *p;
     if (cap > p->v_bounds[0]) sp->v_bounds[1] = cap;
     if (p->progress) {
-        /* the per-node goals brake to the goal themselves (controller_references): no taper, no approach */
+        /* the per-node goals brake to the goal themselves (controller_references): no taper, no approach
+         * weights; the potential's end at the earliest arrival as in the approach (below) */
         int i;
         for (i = 0; i < HM_NX; i++) sp->w_goal[i] = p->progress_weights[i];
         c->in.goal[3] = p->v_ref;
+        if (g->left < p->v_ref * horizon) sp->collision_horizon = controller_arrival(p, sp, g);
         return;
     }
     c->in.goal[3] = hm_fmin(p->v_ref, p->goal_taper * g->left);
@@ -156,10 +170,7 @@ static void controller_solver_params(hm_controller *c, const hm_controller_goal 
          * lower, reached at the upper acceleration bound), plus arrival_margin. Earlier nodes, the
          * distance rows (people's current positions) and the speed-and-separation bound (predictions
          * over the whole horizon) are unchanged. */
-        v_arrive = hm_fmin(p->v_ref, sp->v_bounds[1]);
-        arrival = hm_fmax(g->left - p->goal_tolerance, HM_R(0.0)) / v_arrive +
-                  v_arrive / (HM_R(2.0) * p->a_bounds[1]) + p->arrival_margin;
-        sp->collision_horizon = hm_fmin(p->collision_horizon, arrival);
+        sp->collision_horizon = controller_arrival(p, sp, g);
     }
 }
 
@@ -192,7 +203,7 @@ static void controller_references(hm_controller *c, const hm_controller_input *c
     hm_input *in = &c->in;
     const hm_params *sp = &c->solver.params;
     const hm_real dt = HM_R(HM_DT), a_up = sp->a_bounds[1], a_down = HM_R(-0.5) * sp->a_bounds[0];
-    hm_real v = hm_fmin(hm_fmax(cin->v, HM_R(0.0)), in->goal[3]), d = HM_R(0.0);
+    hm_real v = in->goal[3], d = HM_R(0.0);
     int n;
     for (n = 0; n <= HM_N; n++) {
         const hm_real left = hm_fmax(g->length - g->s_proj - d, HM_R(0.0));
@@ -204,6 +215,22 @@ static void controller_references(hm_controller *c, const hm_controller_input *c
                     hm_sqrt(HM_R(2.0) * a_down * hm_fmax(left - v * dt, HM_R(0.0))));
     }
     in->has_refs = 1;
+}
+
+/* People who stand within goal_clearance of the final goal carry no collision potential: its half-height
+ * distance d_th (1 m) held the robot 1.3-1.9 m short of a goal beside people standing still. The hard
+ * distance d_h, C2 and speed and separation still keep them. */
+static void controller_goal_people(hm_controller *c, const hm_controller_input *cin, const hm_controller_goal *g,
+                                   const hm_controller_output *out)
+{
+    const hm_real r = c->params.goal_clearance;
+    int j;
+    for (j = 0; j < c->in.n_humans; j++) {
+        const hm_real *t = cin->tracks[out->people_index[j]];
+        const hm_real dx = t[0] - g->final[0], dy = t[1] - g->final[1];
+        c->in.humans_no_potential[j] = dx * dx + dy * dy < r * r &&
+                                       t[2] * t[2] + t[3] * t[3] < CONTROLLER_STANDING * CONTROLLER_STANDING;
+    }
 }
 
 /* The length of a planned path. */
@@ -571,6 +598,7 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
     controller_expected_path(s, cin, path);
     controller_select_people(path, cin, &s->params, hm_fmax(hm_fabs(cin->v), s->params.v_bounds[1]), in, out);
     controller_nearest_obstacle(path, cin, c->solver.params.v_bounds[1], in);
+    controller_goal_people(c, cin, &g, out);
     t1 = ocp_nlp_now(s);
     ocp_nlp_sqp_rti_step_from(s, in, &c->out, t0);
     chosen = controller_candidates_step(c, t0, out);

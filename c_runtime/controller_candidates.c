@@ -21,7 +21,7 @@
 #define CANDIDATE_TURN_GAIN HM_R(2.0)
 #define CANDIDATE_LOOKAHEAD 5
 /* SQP iterations from a guide (a guide is no solution: one iteration leaves it far from one). */
-#define CANDIDATE_SEED_ITERATIONS 3
+#define CANDIDATE_SEED_ITERATIONS 1
 
 #if HM_NCAND > 1
 

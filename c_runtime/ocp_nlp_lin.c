@@ -351,7 +351,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
         for (j = 0; j < nh_cost; j++) {
             hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP], hess_exact[HM_NP * HM_NP];
             const hm_real *hess = hess_gn;
-            if (!ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;
+            if (in->humans_no_potential[j] == 1 || !ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;
             if (exact) {
                 hm_model_cost_collision(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn,
                                         hess_exact);

@@ -69,7 +69,8 @@ static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
         nh_cost = ocp_nlp_collision_node(p, n) ? nh : 0;
         for (j = 0; j < nh_cost; j++) {
             hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP];
-            if (!ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;   /* as the linearisation */
+            /* as the linearisation */
+            if (in->humans_no_potential[j] == 1 || !ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;
             hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
             merit += f;
         }

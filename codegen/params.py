@@ -267,11 +267,11 @@ PARAMS: tuple[Param, ...] = (
     Param("lookahead", "controller.lookahead", "real", 0.0,
           "carrot distance along the path (0: v_ref * T, the plan's length at cruising speed)", unit="m",
           valid=Range(0.0, 1e4), controller=True, paper=1e4),
-    Param("progress", "controller.progress", "flag", False,
+    Param("progress", "controller.progress", "flag", True,
           "the progress objective: the OCP tracks a goal per node along the path, each where the robot would be "
           "at the cruising speed (from its speed, within the acceleration bound, braking to arrive at rest), "
           "weighted by progress_weights, instead of one carrot with a speed to track in any direction (the "
-          "paper's objective; goal_taper and the approach then apply)", controller=True),
+          "paper's objective; goal_taper and the approach then apply)", controller=True, paper=False),
     Param("progress_weights", "controller.progress_weights", "vector", (20.0, 20.0, 0.0, 1.0),
           "stage weights on x - g_n with the progress objective (g_n: the node's goal along the path)", size=4,
           valid=_WEIGHT, controller=True),
@@ -279,6 +279,10 @@ PARAMS: tuple[Param, ...] = (
           "with several candidate plans: another plan replaces the one applied last period only when it costs "
           "less by this fraction of its cost (the robot does not switch sides back and forth)",
           valid=Range(0.0, 1.0, hi_open=True), controller=True),
+    Param("goal_clearance", "controller.goal_clearance", "real", 1.5,
+          "people who stand (below 0.2 m/s) within this distance of the final goal carry no collision potential: "
+          "a goal beside people who stand still is reachable up to d_h (the hard distance, C2 and speed and "
+          "separation still apply; 0: every person carries it)", unit="m", valid=_DIST, controller=True, paper=0.0),
     Param("goal_taper", "controller.goal_taper", "real", 0.5,
           "the speed to track is at most goal_taper times the distance left to the goal", unit="1/s",
           valid=Range(0.0, 100.0, lo_open=True), controller=True),

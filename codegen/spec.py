@@ -290,15 +290,16 @@ class Controller:
     max_path_points: int = integer(256, "P: waypoints of the reference path (a fixed size)", ge=2, le=100_000)
     max_obstacle_points: int = integer(256, "K: obstacle points (a scan's or a costmap's) per step (a fixed size)",
                                        ge=1, le=100_000)
-    candidates: int = integer(1, "candidate plans per period (a fixed size): the main plan and ones that pass the "
-                                 "nearest people on either side, the cheapest safe one applied (1: one plan)",
-                              ge=1, le=8)
+    candidates: int = integer(3, "candidate plans per period (a fixed size): the main plan and ones that pass the "
+                                 "nearest people on either side, the cheapest safe one applied (1: one plan; "
+                                 "preset paper: 1)", ge=1, le=8)
     v_ref: float = param("controller.v_ref")
     speed_limit: float = param("controller.speed_limit")
     lookahead: float = param("controller.lookahead")
     progress: bool = param("controller.progress")
     progress_weights: tuple[float, ...] = param("controller.progress_weights")
     candidate_hysteresis: float = param("controller.candidate_hysteresis")
+    goal_clearance: float = param("controller.goal_clearance")
     goal_taper: float = param("controller.goal_taper")
     goal_tolerance: float = param("controller.goal_tolerance")
     yaw_goal_tolerance: float = param("controller.yaw_goal_tolerance")
@@ -464,7 +465,8 @@ def resolve_spec(data: Any, source: str = "spec") -> Spec:
     """Validate a parsed spec (a mapping, or None for all defaults) and fill in the defaults."""
     problems: list[str] = []
     if isinstance(data, Mapping) and data.get("preset") == "paper":
-        data = _with_defaults(data, paper_values())
+        # the paper's objective and one plan (no passing decisions)
+        data = _with_defaults(data, {**paper_values(), "controller.candidates": 1})
     humans = data.get("humans") if isinstance(data, Mapping) else None
     if isinstance(humans, Mapping) and isinstance(humans.get("max"), int) and humans["max"] > _DEFAULT_MAX_TRACKS:
         # The controller takes at least the solver's N_h tracks: a larger N_h raises the default M with it

@@ -112,7 +112,9 @@ def test_the_carrot_lies_lookahead_metres_along_an_l_shaped_path_with_its_headin
 
 
 def test_near_the_goal_the_ocp_sees_the_final_pose_and_arrives_at_rest(ctl: Controller) -> None:
-    """3 m from the goal (less than v_ref * T = 4 m): the final pose with its heading, no speed to track."""
+    """The carrot objective (progress off), 3 m from the goal (less than v_ref * T = 4 m): the final pose
+    with its heading, no speed to track."""
+    ctl.set_params(progress=0)
     r = ctl.step(0.0, pose=(0.0, 0.0, 0.0), v=0.5, goal=(3.0, 0.0, 0.3))
     np.testing.assert_allclose(r.ocp_goal, [3.0, 0.0, 0.3, 0.0], atol=1e-12)
     ctl.set_params(approach=0)
@@ -191,10 +193,12 @@ def test_the_turn_rate_does_not_flip_between_its_bounds_on_the_way_to_a_far_goal
     assert np.max(np.abs(np.diff(omega))) <= 2.0
 
 
-def test_a_person_standing_on_the_straight_line_is_passed_at_d_th_or_more(ctl: Controller) -> None:
+def test_a_person_standing_on_the_straight_line_is_passed_with_room(ctl: Controller) -> None:
+    """Passed at nearly d_th (the potential's half-height, 1 m: a preference the progress objective weighs
+    against the path's length; 0.98 m measured), never within d_h."""
     run = drive(ctl, (0.0, 0.0, 0.0), (10.0, 0.0, 0.0), people=walking((5.0, 0.05, 0.0, 0.0)))
     assert run.results[-1].goal_reached
-    assert run.min_distance() >= D_TH
+    assert run.min_distance() >= 0.9 * D_TH
     assert never_silently_stalled(run, ctl.params["stall_time"])
 
 
@@ -305,12 +309,12 @@ def test_controller_parameters_are_checked_by_their_rules(ctl: Controller) -> No
 
 
 def test_a_loop_after_the_goal_jumps_behind_is_replaced_by_a_recovery_plan(ctl: Controller) -> None:
-    """Cruising at 0.8 m/s with the goal 10 m ahead, the goal jumps 10 m behind: with the paper's speed
+    """The carrot objective, cruising at 0.8 m/s with the goal 10 m ahead, the goal jumps 10 m behind: with the paper's speed
     weight (250, and its free turn rate) the real-time iterations continue the forward plan into a loop;
     the recovery replaces it by a cold SQP plan, so no plan handed out is a loop."""
     def loops(recovery: int) -> tuple[int, int]:
         ctl.reset()
-        ctl.set_params(w_goal=(0.5, 0.5, 0.0, 250.0), w_control=(0.0, 0.0), approach=0,
+        ctl.set_params(w_goal=(0.5, 0.5, 0.0, 250.0), w_control=(0.0, 0.0), approach=0, progress=0,
                        recovery_iterations=recovery)
         x, out, recovered = np.array([0.0, 0.0, 0.0, 0.8]), 0, 0
         for k in range(30):
@@ -348,14 +352,22 @@ def test_a_goal_behind_the_robot_within_the_approach_is_reached(ctl: Controller,
 
 
 def test_a_robot_that_cannot_leave_its_standstill_says_it_is_stalled(ctl: Controller) -> None:
-    """0.4 m straight behind, 0.1 m beyond goal_tolerance: turning around costs the OCP more than the 5 s horizon
-    of standing 0.4 m off, and the recovery from a turn goes back to standing. The controller does not pretend:
-    after stall_time it reports the robot stalled, and it never drives off."""
+    """The carrot objective, 0.4 m straight behind, 0.1 m beyond goal_tolerance: turning around costs the OCP
+    more than the 5 s horizon of standing 0.4 m off, and the recovery from a turn goes back to standing. The
+    controller does not pretend: after stall_time it reports the robot stalled, and it never drives off."""
+    ctl.set_params(progress=0)
     run = drive(ctl, (0.0, 0.0, 0.0), (-0.4, 0.0, 0.0), seconds=8.0)
     assert not run.results[-1].goal_reached
     assert run.results[-1].stalled and run.results[-1].outcome_name == "stalled"
     assert never_silently_stalled(run, stall_time=5.0)
     assert np.max(np.abs(run.xy)) < 0.05
+
+
+def test_with_the_progress_objective_a_goal_just_behind_is_reached(ctl: Controller) -> None:
+    """The same goal 0.4 m behind with the progress objective (the default): its per-node goals on the line
+    behind give the turn a gradient, and the robot gets there."""
+    run = drive(ctl, (0.0, 0.0, 0.0), (-0.4, 0.0, 0.0), seconds=8.0)
+    assert run.results[-1].goal_reached
 
 
 @pytest.mark.parametrize("heading_deg", [90.0, 180.0, -135.0])

@@ -1,0 +1,108 @@
+"""Progress among people: the robot gets where it is going beside a crossing person, behind a slow walker,
+past someone standing on its line, through three people abreast and past a person in a corridor, with
+passing decisions (controller.candidates = 3) and with and without the progress objective.
+
+The plant is the project's own unicycle (the simulation's robot model), driven by the controller's
+commands; people are scripted (they walk as told, whatever the robot does). Bars: the goal reached within
+2 x and the path within 1.5 x those of the free run (nobody there), and the robot never nearer anyone than
+d_h while it moves (a scripted person may walk into a robot that stands in a protective stop: their fault).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import humanmpc
+from humanmpc.controller import Controller
+from humanmpc.sim.robot import RobotModel, step
+from tests.conftest import make_solver
+
+DT = 0.1
+D_H = 0.5
+GOAL = (10.0, 0.0, 0.0)
+
+
+@pytest.fixture(scope="module")
+def passing_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return make_solver(tmp_path_factory.mktemp("passing"), {"name": "passing", "controller": {"candidates": 3}})
+
+
+@pytest.fixture(scope="module", params=[0, 1], ids=["carrot", "progress"])
+def ctl(passing_dir: Path, request: pytest.FixtureRequest) -> Controller:
+    c = humanmpc.load(passing_dir).controller()
+    c.set_params(progress=request.param)
+    return c
+
+
+@dataclass
+class Outcome:
+    time: float           # [s] to the goal, inf when not reached
+    path: float           # [m]
+    closest_moving: float  # [m] to anyone, over the steps where the robot moves
+
+
+def run(ctl: Controller, people: np.ndarray, *, obstacles: np.ndarray | None = None, seconds: float = 40.0) -> Outcome:
+    ctl.reset()
+    model = RobotModel()
+    x = np.zeros(4)
+    length, closest = 0.0, np.inf
+    for k in range(round(seconds / DT)):
+        t = k * DT
+        now = people.copy()
+        now[:, :2] += t * now[:, 2:]
+        r = ctl.step(t, pose=x[:3], v=x[3], goal=GOAL, people=now, obstacles=obstacles)
+        if r.goal_reached:
+            return Outcome(t, length, closest)
+        if len(now) and abs(x[3]) > 0.05:
+            closest = min(closest, float(np.min(np.hypot(*(now[:, :2] - x[:2]).T))))
+        nxt = step(model, x, r.u, DT)
+        length += float(np.hypot(*(nxt[:2] - x[:2])))
+        x = nxt
+    return Outcome(np.inf, length, closest)
+
+
+@pytest.fixture(scope="module")
+def free(ctl: Controller) -> Outcome:
+    return run(ctl, np.zeros((0, 4)))
+
+
+def assert_direct(got: Outcome, free: Outcome) -> None:
+    assert got.time <= 2.0 * free.time, f"{got.time:.1f} s against {free.time:.1f} s free"
+    assert got.path <= 1.5 * free.path, f"{got.path:.2f} m against {free.path:.2f} m free"
+    assert got.closest_moving >= D_H, f"{got.closest_moving:.2f} m from someone while moving"
+
+
+CROSSINGS = [(speed, x0, side) for speed in (0.6, 0.8, 1.0, 1.2) for x0 in (2.0, 3.0, 4.0, 6.0) for side in (-3.0, 3.0)]
+
+
+@pytest.mark.parametrize(("speed", "x0", "side"), CROSSINGS,
+                         ids=[f"{s}mps-x{x:g}-{'right' if y < 0 else 'left'}" for s, x, y in CROSSINGS])
+def test_a_person_crossing_the_robots_way_is_passed(ctl: Controller, free: Outcome, speed: float, x0: float,
+                                                    side: float) -> None:
+    """One person 3 m to one side, walking across the robot's line at 0.6-1.2 m/s (0.8: the robot's own
+    cruising speed, at which the single plan walked beside them for good)."""
+    assert_direct(run(ctl, np.array([[x0, side, 0.0, -np.sign(side) * speed]])), free)
+
+
+def test_a_slow_walker_ahead_is_overtaken(ctl: Controller, free: Outcome) -> None:
+    assert_direct(run(ctl, np.array([[1.5, 0.0, 0.15, 0.0]])), free)
+
+
+def test_a_person_standing_on_the_line_is_passed(ctl: Controller, free: Outcome) -> None:
+    assert_direct(run(ctl, np.array([[4.0, 0.0, 0.0, 0.0]])), free)
+
+
+def test_three_people_abreast_walking_towards_the_robot_are_passed(ctl: Controller, free: Outcome) -> None:
+    got = run(ctl, np.array([[8.0, -0.8, -0.8, 0.0], [8.0, 0.0, -0.8, 0.0], [8.0, 0.8, -0.8, 0.0]]))
+    assert_direct(got, free)
+
+
+def test_a_person_coming_the_other_way_in_a_2_m_corridor_is_passed(ctl: Controller, free: Outcome) -> None:
+    xs = np.arange(-1.0, 12.0, 0.25)
+    walls = np.vstack([np.column_stack([xs, np.full_like(xs, 1.0)]), np.column_stack([xs, np.full_like(xs, -1.0)])])
+    got = run(ctl, np.array([[9.0, 0.0, -0.8, 0.0]]), obstacles=walls)
+    assert_direct(got, free)
