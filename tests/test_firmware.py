@@ -240,14 +240,16 @@ CTL_SEED = 0
 # stays the loop recorded before, whose recovery the targets replay.
 # The replay also reports the goal reached on arrival, whatever the heading (controller.yaw_goal_tolerance above
 # pi): the turn in place to the goal's heading came later and is tested on the host (tests/test_controller.py).
-CTL_PARAMS = {"arrival_margin": 1e4, "yaw_goal_tolerance": 3.2}
+# The scene is the carrot objective's (progress off, every person with the potential): its loop and recovery
+# exercise the most code on the target.
+CTL_PARAMS = {"arrival_margin": 1e4, "yaw_goal_tolerance": 3.2, "progress": 0, "goal_clearance": 0.0}
 # Sizes for a Cortex-M4F: N_h = 5 of up to 8 tracks, a path of up to 32 points, 32 obstacle points,
 # the default horizon (N = 50): the float controller is 196 KB of RAM (docs/firmware.md).
 # The replay's scene was recorded and its tolerances measured with no weight on omega (the default
 # before weights.control = [0, 2]) and without speed and separation (the default since issue 23): with
 # the weight the scene ends before the goal and the stops, with the separation it has no C2 stop.
 CTL_SPEC = {"humans": {"max": 5, "separation": False}, "weights": {"control": [0.0, 0.0]},
-            "controller": {"max_tracks": 8, "max_path_points": 32, "max_obstacle_points": 32}}
+            "controller": {"max_tracks": 8, "max_path_points": 32, "max_obstacle_points": 32, "candidates": 1}}
 @dataclass
 class CtlResult:
     run: fc.ControllerRun
