@@ -18,7 +18,8 @@ from humanmpc.sim.crowd import CrowdSpec
 from humanmpc.sim.scenarios import Scenario
 from humanmpc.sim.world import Polygon, World
 
-PAPER_SPEED_WEIGHT = {"w_goal": (0.5, 0.5, 0.0, 250.0), "w_control": (0.0, 0.0)}  # the paper's weights
+# the paper's weights, with the carrot objective they weigh (the progress objective has weights of its own)
+PAPER_SPEED_WEIGHT = {"w_goal": (0.5, 0.5, 0.0, 250.0), "w_control": (0.0, 0.0), "progress": 0}
 NOBODY = CrowdSpec.build(np.zeros((0, 2)), [], 1.0)
 # A wall across the straight line from (-4, 0) to (4, 0), open above y = 2.
 WALL = World((Polygon.rectangle((0.0, -1.0), 0.4, 6.0),), (-6.0, 6.0, -6.0, 6.0))
