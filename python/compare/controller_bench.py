@@ -136,9 +136,9 @@ def run_controller_bench(spec: Spec | None, tracks: int, *, seeds: int = 3, step
     say(f"[bench] {pin_to_one_core()}; {machine_description()}")
     base = spec or Spec()
     data = base.to_dict()
-    data["name"] = "bench_controller"
+    data["name"] = "benchctl"
     data.setdefault("controller", {})["max_tracks"] = max(tracks, base.humans.max)
-    solver_dir = out_dir / "solvers" / "bench_controller"
+    solver_dir = out_dir / "solvers" / "benchctl"
     generate(resolve_spec(data), solver_dir, force=True, log=say)
     build(solver_dir, log=say)
     ctl = load(solver_dir).controller()
