@@ -309,8 +309,8 @@ def test_controller_parameters_are_checked_by_their_rules(ctl: Controller) -> No
 
 
 def test_a_loop_after_the_goal_jumps_behind_is_replaced_by_a_recovery_plan(ctl: Controller) -> None:
-    """The carrot objective, cruising at 0.8 m/s with the goal 10 m ahead, the goal jumps 10 m behind: with the paper's speed
-    weight (250, and its free turn rate) the real-time iterations continue the forward plan into a loop;
+    """The carrot objective, cruising at 0.8 m/s with the goal 10 m ahead, the goal jumps 10 m behind: with the
+    paper's speed weight (250, and its free turn rate) the real-time iterations continue the forward plan into a loop;
     the recovery replaces it by a cold SQP plan, so no plan handed out is a loop."""
     def loops(recovery: int) -> tuple[int, int]:
         ctl.reset()
