@@ -74,7 +74,7 @@ def _simulate(args: argparse.Namespace) -> int:
     from ..planners.registry import make_planner
     from ..sim.scenarios import make_scenario
     from .episode import run_episode
-    from .metrics import compute_metrics
+    from .metrics import compute_metrics, with_unit
     from .plots import animate_episode, animation_path, figure_path, plot_episodes
 
     try:
@@ -94,7 +94,9 @@ def _simulate(args: argparse.Namespace) -> int:
     metrics = compute_metrics(log)
     print(f"{args.scenario} seed {args.seed} with {args.planner}: ended by {log.ended_by} at t = {log.times[-1]:.1f} s")
     for key, value in metrics.as_row().items():
-        print(f"  {key}: {value:.4g}" if isinstance(value, float) else f"  {key}: {value}")
+        shown = f"{value:.4g}" if isinstance(value, float) else ("yes" if value else "no") \
+            if isinstance(value, bool) else str(value)
+        print(f"  {with_unit(key)}: {shown}")
     if args.plot:
         print(f"plot: {plot_episodes([log], args.plot)}")
     if args.animate:

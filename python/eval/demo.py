@@ -21,7 +21,7 @@ from ..planners.registry import make_planner
 from ..planners.solver_dir import ensure_solver
 from ..sim.scenarios import make_scenario
 from .episode import EpisodeConfig, EpisodeLog, run_episode
-from .metrics import compute_metrics
+from .metrics import compute_metrics, with_unit
 from .plots import plot_episodes
 
 SCENARIO = "crossing_group"  # the default; any registered scenario by name
@@ -39,11 +39,12 @@ def _fmt(value: object) -> str:
 def side_by_side(rows: Mapping[str, Mapping[str, object]]) -> str:
     names = list(rows)
     keys = [k for k in rows[names[0]] if k not in ("scenario", "seed", "planner")]
-    width = max(len(k) for k in keys)
-    lines = [f"{'metric':<{width}}  " + "  ".join(f"{n:>12}" for n in names)]
+    labels = {k: with_unit(k) for k in keys}
+    width = max(len(label) for label in [*labels.values(), "metric [unit]"])
+    lines = [f"{'metric [unit]':<{width}}  " + "  ".join(f"{n:>12}" for n in names)]
     lines.append("-" * len(lines[0]))
     for k in keys:
-        lines.append(f"{k:<{width}}  " + "  ".join(f"{_fmt(rows[n].get(k)):>12}" for n in names))
+        lines.append(f"{labels[k]:<{width}}  " + "  ".join(f"{_fmt(rows[n].get(k)):>12}" for n in names))
     return "\n".join(lines)
 
 
