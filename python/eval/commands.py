@@ -36,6 +36,7 @@ from ..planners.registry import planner_names
 from ..planners.solver_dir import CACHE_DIR, SolverDirError, check_solver_dir, select_solver
 from ..sim.scenarios import CROWD_MODELS, RECORDED_CROSSINGS, RECORDED_SCENARIOS, SCENARIOS, SIMULATED_SCENARIOS
 from .episode import EpisodeConfig
+from .extras import require
 
 
 def choose_solver(spec_file: Path | None, solver_dir: Path | None) -> EpisodeConfig:
@@ -85,8 +86,10 @@ def _simulate(args: argparse.Namespace) -> int:
             animation_path(args.animate)
         scenario = make_scenario(args.scenario, args.seed)
         config = replace(choose_solver(args.spec, args.solver_dir), crowd_model=args.crowd)
+        if args.crowd == "orca" and args.scenario not in RECORDED_SCENARIOS:
+            require("pyrvo", "the ORCA crowd model (--crowd orca)")  # before the solver is built
         planner = make_planner(args.planner)  # an MPC planner generates and builds a --spec's solver here
-    except ValueError as err:
+    except (ValueError, ImportError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
     _print_solver(planner)
@@ -120,11 +123,14 @@ def _evaluate(args: argparse.Namespace) -> int:
         validate_names(scenarios, planners, range(args.first_seed, args.first_seed + args.seeds))
         if args.seeds < 1:
             raise ValueError("--seeds must be >= 1")
+        if "orca" in args.crowds and any(s not in RECORDED_SCENARIOS for s in scenarios):
+            require("pyrvo", "the ORCA crowd model (--crowds orca)")
         grid = parse_grid(args.grid or [])
         config = choose_solver(args.spec, args.solver_dir)
-    except ValueError as err:
+    except (ValueError, ImportError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
+
     def terminated(signum: int, frame: object) -> None:
         raise KeyboardInterrupt  # SIGTERM (a batch system's notice) stops like Ctrl-C: the finished rows are written
 
