@@ -101,7 +101,9 @@ def _simulate(args: argparse.Namespace) -> int:
             if isinstance(value, bool) else str(value)
         print(f"  {with_unit(key)}: {shown}")
     if args.plot:
-        print(f"plot: {plot_episodes([log], args.plot)}")
+        crowd = "recorded people" if args.scenario in RECORDED_SCENARIOS else f"{args.crowd} crowd"
+        title = f"{args.scenario}, {crowd}, seed {args.seed}: {args.planner}"
+        print(f"plot: {plot_episodes([log], args.plot, title=title)}")
     if args.animate:
         try:
             print(f"animation: {animate_episode(log, args.animate)}")

@@ -71,6 +71,7 @@ def run_demo(seed: int = 0, out_dir: Path = Path("out/demo"), scenario_name: str
         say(f"[demo] {scenario_name} seed {seed}: running {name} ...")
         logs[name] = run_episode(scenario, planner, config)
     rows = {name: compute_metrics(log).as_row() for name, log in logs.items()}
+    crowd = "recorded people" if scenario.recorded else f"{(config or EpisodeConfig()).crowd_model} crowd"
     print(f"\n{scenario_name}, seed {seed}: HuMAN-MPC (generated C, SQP-RTI) vs the DWB baseline")
     print("mpc: the evaluation's configuration (global-path carrot, loop restart, exact-Hessian RTI, "
           "q = 50, w_v = 50, ...); "
@@ -79,7 +80,8 @@ def run_demo(seed: int = 0, out_dir: Path = Path("out/demo"), scenario_name: str
     print()
     print(timing_summary(logs))
     figure = plot_episodes(list(logs.values()), Path(out_dir) / f"{scenario_name}_seed{seed}.png",
-                           title=f"{scenario_name}, seed {seed}: MPC (red), MPC paper config (orange), DWB (blue)")
+                           title=f"{scenario_name}, {crowd}, seed {seed}: the MPC (evaluation's configuration), "
+                           "the MPC in the paper's configuration, the DWB baseline")
     print(f"\nfigure: {figure.resolve()}")
     say(f"[demo] done in {time.perf_counter() - started:.1f} s")
     return figure
