@@ -212,7 +212,8 @@ def machine_description() -> str:
 def markdown_table(results: Sequence[BenchResult]) -> str:
     rows = [
         "| N_h [people] | steps [count] | C step mean / median / min / max / p99 [ms] "
-        "| Python step mean / p99 / max [ms] | solved steps: C / Python mean [ms] | prep. share [% of step] | QP iter mean / max [count] "
+        "| Python step mean / p99 / max [ms] | solved steps: C / Python mean [ms] | prep. share [% of step] "
+        "| QP iter mean / max [count] "
         "| QP status [steps] | stops [steps] | min dist [m] |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
