@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import sys
 from collections.abc import Sequence
 
@@ -11,7 +12,8 @@ from .eval.commands import add_demo_parser, add_evaluate_parser, add_report_pars
 from .firmware.commands import add_firmware_parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def build_parser() -> argparse.ArgumentParser:
+    """The whole command line: the generator's commands and the tools'."""
     parser = make_parser()
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     add_generator_commands(sub)
@@ -21,7 +23,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     add_report_parser(sub)
     add_firmware_parser(sub)
     add_demo_parser(sub)
-    return run(parser, argv, GENERATOR_ERRORS)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    return run(build_parser(), argv, GENERATOR_ERRORS)
 
 
 if __name__ == "__main__":

@@ -59,7 +59,8 @@ def test_evaluation_writes_tables_and_figures_with_parallel_workers(tmp_path: Pa
     assert len(rows) == 2 and {"success", "min_human_distance", "planner_ms_p99", "crowd"} <= rows[0].keys()
     assert {r["worker"] for r in rows} != {""}
     table = (tmp_path / "summary.md").read_text()
-    assert table.startswith("| scenario | crowd | planner | runs |")
+    assert table.startswith("Each cell: mean ± standard deviation")
+    assert "| scenario | crowd | planner | runs [count] |" in table
     assert "| circle_crossing | social_force | dwb | 2 |" in table
     assert (tmp_path / "figures" / "circle_crossing_social_force_seed0.png").is_file()
     assert "## Headline" in (tmp_path / "report.md").read_text()

@@ -211,8 +211,10 @@ def machine_description() -> str:
 
 def markdown_table(results: Sequence[BenchResult]) -> str:
     rows = [
-        "| N_h | steps | C step mean / median / min / max / p99 [ms] | Python step mean / p99 / max [ms] "
-        "| solved steps: C / Python mean [ms] | prep. share | QP iter mean / max | QP status | stops | min dist [m] |",
+        "| N_h [people] | steps [count] | C step mean / median / min / max / p99 [ms] "
+        "| Python step mean / p99 / max [ms] | solved steps: C / Python mean [ms] | prep. share [% of step] "
+        "| QP iter mean / max [count] "
+        "| QP status [steps] | stops [steps] | min dist [m] |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in results:

@@ -384,8 +384,9 @@ def markdown_section(rows: Sequence[SolverStats], machine: dict[str, str], comma
         "Ipopt found feasible (hard rows are not in the cost). `humanmpc exact+LS`: the same generated solver",
         "with the runtime parameters exact_hessian and line_search on (the behaviour evaluation's RTI).",
         "",
-        "| N_h | solver | mean ms | median ms | min ms | max ms | p99 ms | × ours (mean) | × ours (median) | "
-        "iterations (mean/max) | failures | RCSO | RCSO common (steps) | violation m |",
+        "| N_h [people] | solver | mean [ms] | median [ms] | min [ms] | max [ms] | p99 [ms] | × ours (mean) [ratio] "
+        "| × ours (median) [ratio] | iterations (mean/max) [count] | failures [steps] | RCSO [ratio] "
+        "| RCSO common (steps) [ratio] | violation [m] |",
         "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:

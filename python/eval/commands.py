@@ -36,6 +36,7 @@ from ..planners.registry import planner_names
 from ..planners.solver_dir import CACHE_DIR, SolverDirError, check_solver_dir, select_solver
 from ..sim.scenarios import CROWD_MODELS, RECORDED_CROSSINGS, RECORDED_SCENARIOS, SCENARIOS, SIMULATED_SCENARIOS
 from .episode import EpisodeConfig
+from .extras import require
 
 
 def choose_solver(spec_file: Path | None, solver_dir: Path | None) -> EpisodeConfig:
@@ -74,7 +75,7 @@ def _simulate(args: argparse.Namespace) -> int:
     from ..planners.registry import make_planner
     from ..sim.scenarios import make_scenario
     from .episode import run_episode
-    from .metrics import compute_metrics
+    from .metrics import compute_metrics, with_unit
     from .plots import animate_episode, animation_path, figure_path, plot_episodes
 
     try:
@@ -85,8 +86,10 @@ def _simulate(args: argparse.Namespace) -> int:
             animation_path(args.animate)
         scenario = make_scenario(args.scenario, args.seed)
         config = replace(choose_solver(args.spec, args.solver_dir), crowd_model=args.crowd)
+        if args.crowd == "orca" and args.scenario not in RECORDED_SCENARIOS:
+            require("pyrvo", "the ORCA crowd model (--crowd orca)")  # before the solver is built
         planner = make_planner(args.planner)  # an MPC planner generates and builds a --spec's solver here
-    except ValueError as err:
+    except (ValueError, ImportError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
     _print_solver(planner)
@@ -94,9 +97,13 @@ def _simulate(args: argparse.Namespace) -> int:
     metrics = compute_metrics(log)
     print(f"{args.scenario} seed {args.seed} with {args.planner}: ended by {log.ended_by} at t = {log.times[-1]:.1f} s")
     for key, value in metrics.as_row().items():
-        print(f"  {key}: {value:.4g}" if isinstance(value, float) else f"  {key}: {value}")
+        shown = f"{value:.4g}" if isinstance(value, float) else ("yes" if value else "no") \
+            if isinstance(value, bool) else str(value)
+        print(f"  {with_unit(key)}: {shown}")
     if args.plot:
-        print(f"plot: {plot_episodes([log], args.plot)}")
+        crowd = "recorded people" if args.scenario in RECORDED_SCENARIOS else f"{args.crowd} crowd"
+        title = f"{args.scenario}, {crowd}, seed {args.seed}: {args.planner}"
+        print(f"plot: {plot_episodes([log], args.plot, title=title)}")
     if args.animate:
         try:
             print(f"animation: {animate_episode(log, args.animate)}")
@@ -118,11 +125,14 @@ def _evaluate(args: argparse.Namespace) -> int:
         validate_names(scenarios, planners, range(args.first_seed, args.first_seed + args.seeds))
         if args.seeds < 1:
             raise ValueError("--seeds must be >= 1")
+        if "orca" in args.crowds and any(s not in RECORDED_SCENARIOS for s in scenarios):
+            require("pyrvo", "the ORCA crowd model (--crowds orca)")
         grid = parse_grid(args.grid or [])
         config = choose_solver(args.spec, args.solver_dir)
-    except ValueError as err:
+    except (ValueError, ImportError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
+
     def terminated(signum: int, frame: object) -> None:
         raise KeyboardInterrupt  # SIGTERM (a batch system's notice) stops like Ctrl-C: the finished rows are written
 

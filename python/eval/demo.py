@@ -21,7 +21,7 @@ from ..planners.registry import make_planner
 from ..planners.solver_dir import ensure_solver
 from ..sim.scenarios import make_scenario
 from .episode import EpisodeConfig, EpisodeLog, run_episode
-from .metrics import compute_metrics
+from .metrics import compute_metrics, with_unit
 from .plots import plot_episodes
 
 SCENARIO = "crossing_group"  # the default; any registered scenario by name
@@ -39,11 +39,12 @@ def _fmt(value: object) -> str:
 def side_by_side(rows: Mapping[str, Mapping[str, object]]) -> str:
     names = list(rows)
     keys = [k for k in rows[names[0]] if k not in ("scenario", "seed", "planner")]
-    width = max(len(k) for k in keys)
-    lines = [f"{'metric':<{width}}  " + "  ".join(f"{n:>12}" for n in names)]
+    labels = {k: with_unit(k) for k in keys}
+    width = max(len(label) for label in [*labels.values(), "metric [unit]"])
+    lines = [f"{'metric [unit]':<{width}}  " + "  ".join(f"{n:>12}" for n in names)]
     lines.append("-" * len(lines[0]))
     for k in keys:
-        lines.append(f"{k:<{width}}  " + "  ".join(f"{_fmt(rows[n].get(k)):>12}" for n in names))
+        lines.append(f"{labels[k]:<{width}}  " + "  ".join(f"{_fmt(rows[n].get(k)):>12}" for n in names))
     return "\n".join(lines)
 
 
@@ -70,6 +71,7 @@ def run_demo(seed: int = 0, out_dir: Path = Path("out/demo"), scenario_name: str
         say(f"[demo] {scenario_name} seed {seed}: running {name} ...")
         logs[name] = run_episode(scenario, planner, config)
     rows = {name: compute_metrics(log).as_row() for name, log in logs.items()}
+    crowd = "recorded people" if scenario.recorded else f"{(config or EpisodeConfig()).crowd_model} crowd"
     print(f"\n{scenario_name}, seed {seed}: HuMAN-MPC (generated C, SQP-RTI) vs the DWB baseline")
     print("mpc: the evaluation's configuration (global-path carrot, loop restart, exact-Hessian RTI, "
           "q = 50, w_v = 50, ...); "
@@ -78,7 +80,8 @@ def run_demo(seed: int = 0, out_dir: Path = Path("out/demo"), scenario_name: str
     print()
     print(timing_summary(logs))
     figure = plot_episodes(list(logs.values()), Path(out_dir) / f"{scenario_name}_seed{seed}.png",
-                           title=f"{scenario_name}, seed {seed}: MPC (red), MPC paper config (orange), DWB (blue)")
+                           title=f"{scenario_name}, {crowd}, seed {seed}: the MPC (evaluation's configuration), "
+                           "the MPC in the paper's configuration, the DWB baseline")
     print(f"\nfigure: {figure.resolve()}")
     say(f"[demo] done in {time.perf_counter() - started:.1f} s")
     return figure

@@ -35,6 +35,7 @@ from .campaign import Campaign, EpisodeTask, ParamValue, PlannerConfig, SolverRe
 from .engines import make_engine
 from .episode import EpisodeConfig
 from .extras import arrow, require
+from .metrics import unit, with_unit
 from .report import write_report
 from .runner import run_campaign
 from .store import ResultStore
@@ -109,10 +110,19 @@ def write_csv(rows: Sequence[Row], path: Path) -> None:
         writer.writerows(rows)
 
 
+SUMMARY_NOTE = ("Each cell: mean ± standard deviation over the runs (the spread of the episodes, not a "
+                "confidence interval: report.md has those); yes/no columns as the fraction of runs [0..1].")
+
+
+def _summary_header(column: str) -> str:
+    return f"{column} [0..1]" if unit(column) == "yes/no" else with_unit(column)
+
+
 def markdown_table(summary: Sequence[Row]) -> str:
-    """The summary as a Markdown table, ``mean ± std`` per cell."""
+    """The summary as a Markdown table, ``mean ± std`` per cell (explained by :data:`SUMMARY_NOTE`, its
+    first line), every header with its unit."""
     names = ["scenario", "crowd", "planner"] if summary and "crowd" in summary[0] else ["scenario", "planner"]
-    header = [*names, "runs", *SUMMARY_COLUMNS]
+    header = [*names, "runs [count]", *(_summary_header(c) for c in SUMMARY_COLUMNS)]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for s in summary:
         cells = [*(str(s[n]) for n in names), str(s["runs"])]
@@ -120,13 +130,13 @@ def markdown_table(summary: Sequence[Row]) -> str:
             m, sd = float(s[f"{col}_mean"]), float(s[f"{col}_std"])
             cells.append("n/a" if math.isnan(m) else f"{m:.3g} ± {sd:.2g}")
         lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
+    return SUMMARY_NOTE + "\n\n" + "\n".join(lines) + "\n"
 
 
 SAFETY_HEADER = (
-    "| scenario | planner | runs | goals reached | robot-fault contacts: events / steps | runs with a robot-fault "
-    "contact | person-fault contacts: events / steps | min distance, median of runs [m] | time in protective stop, "
-    "mean [s] | freezing: events / mean time [s] |"
+    "| scenario | planner | runs [count] | goals reached [runs] | robot-fault contacts [events / steps] "
+    "| runs with a robot-fault contact [runs] | person-fault contacts [events / steps] "
+    "| min distance, median of runs [m] | time in protective stop, mean [s] | freezing [events / mean s] |"
 )
 
 

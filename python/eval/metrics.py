@@ -131,6 +131,32 @@ class EpisodeMetrics:
         return row
 
 
+# The unit of every column of :meth:`EpisodeMetrics.as_row`, for the tables' headers ("yes/no": a flag;
+# "events": entries into a state, counted; "steps": control periods of 0.1 s).
+UNITS: dict[str, str] = {
+    "success": "yes/no", "reached_goal": "yes/no", "timeout": "yes/no",
+    "collisions": "events", "human_collisions": "events", "obstacle_collisions": "events", "collision_time": "s",
+    "robot_fault_contacts": "events", "person_fault_contacts": "events",
+    "robot_fault_steps": "steps", "person_fault_steps": "steps",
+    "time_to_goal": "s", "path_length": "m", "spl": "0..1", "min_human_distance": "m",
+    "min_time_to_collision": "s", "time_within_dth": "s", "time_intimate": "s", "time_personal": "s",
+    "time_social": "s", "protective_stops": "events", "stop_time": "s", "freezing_events": "events",
+    "freezing_time": "s", "path_irregularity": "rad/m", "mean_jerk": "m/s^3", "omega_flip_rate": "0..1",
+    "planner_ms_mean": "ms", "planner_ms_p99": "ms", "planner_ms_max": "ms",
+    "people_speed_change": "m/s", "people_heading_change": "rad",
+}
+
+
+def unit(column: str) -> str:
+    """The unit of a metric column (``stops[reason]`` columns count events); KeyError for an unknown one."""
+    return "events" if column.startswith("stops[") else UNITS[column]
+
+
+def with_unit(column: str) -> str:
+    """``time_social [s]``: a column's name with its unit, for a table's header."""
+    return f"{column} [{unit(column)}]"
+
+
 def rising_edges(flags: NDArray[np.bool_]) -> NDArray[np.int64]:
     """Indices where a boolean series switches on (index 0 if it starts on)."""
     f = np.asarray(flags, dtype=bool)

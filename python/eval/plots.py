@@ -11,7 +11,8 @@ person's track a thin line from a hollow disc where they were first seen, with a
 along it in their direction of walking (legend entry "people"). Contacts are marked at the robot's
 position where they start: a black cross where the robot was at fault (it moved with the person within
 +-90 degrees of its heading, :func:`humanmpc.eval.metrics.robot_at_fault`), a white one where the person
-was. Simulated people react to the robot, so every episode has its own map.
+was, an orange square where the robot's disc reached a wall or obstacle. The legend sits below each map,
+outside the scene. Simulated people react to the robot, so every episode has its own map.
 """
 
 from __future__ import annotations
@@ -106,30 +107,53 @@ def contact_starts(log: EpisodeLog) -> tuple[np.ndarray, np.ndarray]:
     return np.array(sorted(robot), dtype=int), np.array(sorted(person), dtype=int)
 
 
+def wall_contact_starts(log: EpisodeLog) -> np.ndarray:
+    """The samples at which a contact with an obstacle or wall starts (the robot's disc reaches it)."""
+    contact = log.world.signed_distance(log.states[:, :2]) < log.robot.radius
+    return np.asarray(rising_edges(np.asarray(contact, dtype=bool)), dtype=int)
+
+
+WALL_MARK = {"marker": "s", "mfc": "orange", "mec": "black"}
+
+
 def draw_contacts(ax: Axes, log: EpisodeLog) -> None:
     robot, person = contact_starts(log)
+    wall = wall_contact_starts(log)
     xy = log.states[:, :2]
     if robot.size:
         ax.plot(xy[robot, 0], xy[robot, 1], ls="none", marker="X", ms=11, mfc="black", mec="white", zorder=6)
     if person.size:
         ax.plot(xy[person, 0], xy[person, 1], ls="none", marker="X", ms=11, mfc="white", mec="black", zorder=6)
+    if wall.size:
+        ax.plot(xy[wall, 0], xy[wall, 1], ls="none", ms=9, zorder=6, **WALL_MARK)  # type: ignore[arg-type]
 
 
 def legend_handles(colour: str, label: str) -> list[Line2D]:
-    """The map's legend: the robot's path, the people, the two contact marks, start and goal."""
+    """The map's legend: the robot's path, the people, the three contact marks, start and goal."""
     return [
         Line2D([], [], color=colour, lw=2.0, label=label),
         Line2D([], [], color=PEOPLE_COLOUR, lw=1.0, marker=r"$\rightarrow$", ms=9,
-               label="people (arrows: walking direction)"),
+               label="people, one shade of green each\n(circle: first seen; arrows: walking)"),
         Line2D([], [], ls="none", marker="X", ms=9, mfc="black", mec="white", label="contact, robot's fault"),
         Line2D([], [], ls="none", marker="X", ms=9, mfc="white", mec="black", label="contact, person's fault"),
-        Line2D([], [], ls="none", marker="o", ms=8, mfc="white", mec="k", label="start"),
+        Line2D([], [], ls="none", ms=8, label="contact with a wall or obstacle", **WALL_MARK),  # type: ignore[arg-type]
+        Line2D([], [], ls="none", marker="o", ms=8, mfc="white", mec="k", label="robot's start"),
         Line2D([], [], ls="none", marker="*", ms=12, color="gold", mec="k", label="goal"),
+        Line2D([], [], ls="none", marker="s", ms=8, color="0.35", label="obstacles, walls"),
     ]
 
 
+ENDED_BY = {"goal": "reached the goal", "time_limit": "timed out", "collision": "ended by a contact"}
+
+
+def path_label(log: EpisodeLog) -> str:
+    """``robot path, mpc: reached the goal``: the planner's line and how its episode ended, in words."""
+    return f"robot path, {log.planner}: {ENDED_BY.get(log.ended_by, 'ended: ' + log.ended_by)}"
+
+
 def draw_map(ax: Axes, log: EpisodeLog, colour: str) -> None:
-    """One episode on its map: world, people, robot path, contacts, start and goal, legend."""
+    """One episode on its map: world, people, robot path, contacts, start and goal; the legend below the
+    map, outside the scene, so that it covers neither the start nor anyone's path."""
     draw_world(ax, log.world)
     draw_humans(ax, log)
     xy = log.states[:, :2]
@@ -137,7 +161,8 @@ def draw_map(ax: Axes, log: EpisodeLog, colour: str) -> None:
     draw_contacts(ax, log)
     ax.plot(*xy[0], marker="o", ms=10, mfc="white", mec="k", zorder=5)
     ax.plot(*log.goal[:2], marker="*", ms=15, color="gold", mec="k", zorder=5)
-    ax.legend(handles=legend_handles(colour, f"{log.planner} ({log.ended_by})"), loc="upper left", fontsize=7)
+    ax.legend(handles=legend_handles(colour, path_label(log)), loc="upper center", bbox_to_anchor=(0.5, 0.0),
+              borderaxespad=4.0, ncol=2, fontsize=7, frameon=False)
 
 
 def figure_path(path: str | Path) -> Path:
@@ -166,8 +191,8 @@ def plot_episodes(logs: Sequence[EpisodeLog], path: str | Path, title: str | Non
     out = figure_path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     n = len(logs)
-    fig = plt.figure(figsize=(max(7.5, 5.2 * n), 10.0))
-    grid = fig.add_gridspec(3, n, height_ratios=[3.2, 1, 1])
+    fig = plt.figure(figsize=(max(7.5, 5.2 * n), 11.5))
+    grid = fig.add_gridspec(3, n, height_ratios=[4.2, 1, 1])
     ax_d = fig.add_subplot(grid[1, :])
     ax_t = fig.add_subplot(grid[2, :], sharex=ax_d)
     first = logs[0]
@@ -186,7 +211,7 @@ def plot_episodes(logs: Sequence[EpisodeLog], path: str | Path, title: str | Non
     ax_d.axhline(r_sum, color="k", ls=":", lw=1, label="contact")
     ax_d.set_ylabel("nearest human [m]")
     ax_d.set_ylim(0, 4)
-    ax_d.legend(fontsize=7, loc="upper right")
+    ax_d.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     ax_t.set_ylabel("planner time [ms]")
     ax_t.set_xlabel("t [s]")
     fig.tight_layout()

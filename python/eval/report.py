@@ -26,8 +26,9 @@ import matplotlib.pyplot as plt
 
 from ..sim.robot import RobotModel
 from ..sim.scenarios import make_scenario
+from .metrics import TTC_CAP
 from .plots import planner_colour, plot_episodes
-from .stats import Interval, format_mean, format_rate, mean_interval, wilson
+from .stats import MIN_N, Interval, format_mean, format_rate, mean_interval, wilson
 from .store import ResultStore
 from .traces import trace_to_log
 
@@ -44,22 +45,24 @@ RATES: list[tuple[str, Callable[[Row], bool]]] = [
     ("freezing [%]", lambda r: int(r["freezing_events"]) > 0),
     ("protective stop [%]", lambda r: int(r["protective_stops"]) > 0),
 ]
-# (header with its unit, column); time to goal over the episodes that reached it (NaN otherwise)
-MEANS: list[tuple[str, str]] = [
-    ("SPL [0..1]", "spl"),
-    ("time to goal [s]", "time_to_goal"),
-    ("path length [m]", "path_length"),
-    ("min distance [m]", "min_human_distance"),
-    ("min time to collision [s]", "min_time_to_collision"),
-    ("intimate < 0.45 m [s]", "time_intimate"),
-    ("personal 0.45-1.2 m [s]", "time_personal"),
-    ("social 1.2-3.6 m [s]", "time_social"),
-    ("path irregularity [rad/m]", "path_irregularity"),
-    ("jerk [m/s³]", "mean_jerk"),
-    ("freezing [s]", "freezing_time"),
-    ("protective stops [per episode]", "protective_stops"),
-    ("people's speed change [m/s]", "people_speed_change"),
-    ("people's heading change [rad]", "people_heading_change"),
+# (header with its unit, column, the quantity's range); time to goal over the episodes that reached it (NaN
+# otherwise). The t intervals are clipped to the range.
+POSITIVE = (0.0, math.inf)
+MEANS: list[tuple[str, str, tuple[float, float]]] = [
+    ("SPL [0..1]", "spl", (0.0, 1.0)),
+    ("time to goal [s]", "time_to_goal", POSITIVE),
+    ("path length [m]", "path_length", POSITIVE),
+    ("min distance [m]", "min_human_distance", POSITIVE),
+    ("min time to collision [s]", "min_time_to_collision", (0.0, TTC_CAP)),
+    ("intimate < 0.45 m [s]", "time_intimate", POSITIVE),
+    ("personal 0.45-1.2 m [s]", "time_personal", POSITIVE),
+    ("social 1.2-3.6 m [s]", "time_social", POSITIVE),
+    ("path irregularity [rad/m]", "path_irregularity", POSITIVE),
+    ("jerk [m/s³]", "mean_jerk", POSITIVE),
+    ("freezing [s]", "freezing_time", POSITIVE),
+    ("protective stops [per episode]", "protective_stops", POSITIVE),
+    ("people's speed change [m/s]", "people_speed_change", POSITIVE),
+    ("people's heading change [rad]", "people_heading_change", POSITIVE),
 ]
 HEADLINE_RATES = ("success [%]", "contact, robot's fault [%]")
 HEADLINE_MEANS = ("SPL [0..1]", "time to goal [s]", "min distance [m]", "people's speed change [m/s]")
@@ -82,7 +85,8 @@ class Cell:
         return wilson(sum(1 for r in self.rows if test(r)), len(self.rows))
 
     def mean(self, column: str) -> Interval:
-        return mean_interval([float(r[column]) for r in self.rows])
+        bounds = next((b for _, c, b in MEANS if c == column), POSITIVE)
+        return mean_interval([float(r[column]) for r in self.rows], bounds=bounds)
 
 
 def cells(rows: Sequence[Row], description: dict[str, Any] | None = None) -> list[Cell]:
@@ -110,7 +114,7 @@ def _table(header: Sequence[str], lines: Sequence[Sequence[str]]) -> str:
 
 def headline_table(cs: Sequence[Cell]) -> str:
     header = ["scenario", "crowd", "people", "planner", "episodes", *HEADLINE_RATES, *HEADLINE_MEANS]
-    means = dict((h, c) for h, c in MEANS)
+    means = {h: c for h, c, _ in MEANS}
     return _table(header, [[c.scenario, c.crowd, c.people, c.planner, str(len(c.rows)),
                             *(format_rate(c.rate(h)) for h in HEADLINE_RATES),
                             *(format_mean(c.mean(means[h])) for h in HEADLINE_MEANS)] for c in cs])
@@ -123,8 +127,8 @@ def rates_table(cs: Sequence[Cell]) -> str:
 
 
 def means_table(cs: Sequence[Cell]) -> str:
-    header = ["scenario", "crowd", "planner", *(h for h, _ in MEANS)]
-    return _table(header, [[c.scenario, c.crowd, c.planner, *(format_mean(c.mean(col)) for _, col in MEANS)]
+    header = ["scenario", "crowd", "planner", *(h for h, _, _ in MEANS)]
+    return _table(header, [[c.scenario, c.crowd, c.planner, *(format_mean(c.mean(col)) for _, col, _ in MEANS)]
                            for c in cs])
 
 
@@ -170,7 +174,8 @@ def success_figure(cs: Sequence[Cell], path: Path) -> Path:
             points.sort()
             x = [counts.index(p) + (i - (len(lines) - 1) / 2) * dodge for p, _ in points]
             y = [100 * iv.value for _, iv in points]
-            err = [[100 * (iv.value - iv.low) for _, iv in points], [100 * (iv.high - iv.value) for _, iv in points]]
+            err = [[max(0.0, 100 * (iv.value - iv.low)) for _, iv in points],
+                   [max(0.0, 100 * (iv.high - iv.value)) for _, iv in points]]
             ax.errorbar(x, y, yerr=err, marker="o", capsize=3, color=planner_colour(planner, i), label=planner)
         ax.set_xticks(range(len(counts)), [str(c) for c in counts])
         ax.set_xlim(-0.5, len(counts) - 0.5)
@@ -240,12 +245,15 @@ def write_report(folder: str | Path, out: str | Path | None = None, figures: boo
         "",
         "Rates are per cent of the cell's episodes with their 95 % Wilson score interval [low, high]; means "
         "are over the cell's episodes with their 95 % Student t interval (time to goal over the episodes that "
-        "reached it). Distances are centre to centre; contacts at robot radius + person radius; the metrics "
+        f"reached it). A mean of fewer than {MIN_N} values has no interval and shows its count, `0.440 (n=2)`; "
+        "a t interval that reaches beyond the quantity's range (below 0, SPL above 1, time to collision above "
+        f"{TTC_CAP:g} s) is clipped to it and marked `*`: with few episodes it is then a rough bound, not a 95 % "
+        "interval. Distances are centre to centre; contacts at robot radius + person radius; the metrics "
         "are defined in python/eval/metrics.py.", "",
         "## Runs", "", runs_table(store.runs()),
         "## Headline", "", headline_table(cs),
         "## Rates [% of episodes, 95 % Wilson interval]", "", rates_table(cs),
-        "## Means [95 % t interval]", "", means_table(cs),
+        f"## Means [95 % t interval, clipped to the range: *; none below {MIN_N} episodes]", "", means_table(cs),
         "## Protective stops by reason [events, all episodes of the cell]", "", stops_table(cs),
     ]
     if figures:

@@ -28,7 +28,7 @@ their median: from the 10th to the 90th percentile of the positions along that a
 of the scene people walk through), so a crossing is 10.7 m (hotel) to 13.5 m (eth) long. Seed ``s`` is crossing
 ``s``: start time ``s // 2``, direction ``s % 2`` (0: towards increasing position along the
 axis, oriented so that its larger component is positive; 1: back). The first four start times
-(crossings 0..7, the ones issue 23's bars are stated on) are one per quarter of the recording's
+(crossings 0..7, the hardest, which the earliest measurements used) are one per quarter of the recording's
 admissible starts (those that leave ``RECORDED_TIME_LIMIT`` of recording), the busiest in it: the
 largest mean number of people present over the crossing's nominal duration (its length at v_ref,
 sampled every 0.4 s), among the start times at which nobody is within 1 m of either end of the
