@@ -42,6 +42,7 @@ RUNTIME_SOURCES = (
     "ocp_qp_ipm.c",
     "ocp_nlp_common.c",
     "monitor.c",
+    "ocp_nlp_cost.c",
     "ocp_nlp_lin.c",
     "ocp_nlp_screen.c",
     "ocp_nlp_step.c",
