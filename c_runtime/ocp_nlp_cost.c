@@ -62,8 +62,8 @@ HM_FUNC hm_real ocp_nlp_cost_tracking(const hm_params *p, const hm_input *in, in
     return l;
 }
 
-HM_FUNC void ocp_nlp_cost_people(const hm_params *p, const hm_input *in, const ocp_nlp_terms *t, int n,
-                                 const hm_real *x, int exact, hm_real *acc, hm_real *gx, hm_real *hx)
+HM_FUNC hm_real ocp_nlp_cost_people(const hm_params *p, const hm_input *in, const ocp_nlp_terms *t, int n,
+                                    const hm_real *x, int exact, hm_real acc, hm_real *gx, hm_real *hx)
 {
     /* the people whose potential this node carries: none beyond the potential's horizon */
     const int nh_cost = ocp_nlp_collision_node(p, n) ? t->nh : 0;
@@ -79,7 +79,7 @@ HM_FUNC void ocp_nlp_cost_people(const hm_params *p, const hm_input *in, const o
         } else {
             hm_model_cost_collision_gn(x, h, &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
         }
-        *acc += f;
+        acc += f;
         if (gx == 0) continue;
         /* exact gradient; the Hessian on the (px, py) block */
         gx[0] += grad[0];
@@ -89,6 +89,7 @@ HM_FUNC void ocp_nlp_cost_people(const hm_params *p, const hm_input *in, const o
         hx[HM_NX] += hess[2];
         hx[HM_NX + 1] += hess[3];
     }
+    return acc;
 }
 
 HM_FUNC hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2)
@@ -117,7 +118,7 @@ HM_FUNC hm_real ocp_nlp_objective(const hm_solver *s, const hm_input *in)
         const hm_real *x = s->x[n];
         hm_real gx[HM_NX], hx[HM_NX * HM_NX], gu[HM_NU], hu[HM_NU * HM_NU];
         cost += ocp_nlp_cost_tracking(p, in, n, x, n < HM_N ? s->u[n] : 0, gx, gu, hx, hu);
-        ocp_nlp_cost_people(p, in, &t, n, x, 0, &cost, 0, 0);
+        cost = ocp_nlp_cost_people(p, in, &t, n, x, 0, cost, 0, 0);
         /* node 0 is the measured state: its rows cannot be acted on */
         if (n == 0) continue;
         for (j = 0; j < t.ng; j++) {

@@ -37,11 +37,12 @@ HM_FUNC hm_real ocp_nlp_cost_tracking(const hm_params *p, const hm_input *in, in
                                       const hm_real *u, hm_real *gx, hm_real *gu, hm_real *hx, hm_real *hu);
 
 /* The collision potential of node n at x: every present person within its horizon and reach and not
- * exempt (humans_no_potential), at their predicted position. Each value is added to *acc in turn;
- * with gx non-null, each gradient and Hessian (exact = 1: exact, else Gauss-Newton) is added to the
- * (px, py) entries of gx and of hx (column-major, HM_NX rows). */
-HM_FUNC void ocp_nlp_cost_people(const hm_params *p, const hm_input *in, const ocp_nlp_terms *t, int n,
-                                 const hm_real *x, int exact, hm_real *acc, hm_real *gx, hm_real *hx);
+ * exempt (humans_no_potential), at their predicted position. Returns acc with each value added in
+ * turn (a caller's running sum, so that every caller adds in the same order); with gx non-null, each
+ * gradient and Hessian (exact = 1: exact, else Gauss-Newton) is added to the (px, py) entries of gx
+ * and of hx (column-major, HM_NX rows). */
+HM_FUNC hm_real ocp_nlp_cost_people(const hm_params *p, const hm_input *in, const ocp_nlp_terms *t, int n,
+                                    const hm_real *x, int exact, hm_real acc, hm_real *gx, hm_real *hx);
 
 /* The cost of the slack that a row with value g needs (s = max(0, -g)), penalised by l1 and l2. */
 HM_FUNC hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2);

@@ -337,7 +337,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
 
         /* Collision cost of each present person within reach at their predicted position at this
          * node: exact gradient, Gauss-Newton (or exact) Hessian on the (px, py) block. */
-        ocp_nlp_cost_people(p, in, &t, n, x, exact, &cost, q, Q);
+        cost = ocp_nlp_cost_people(p, in, &t, n, x, exact, cost, q, Q);
 
         /* Node 0 is the measured state: its bounds and rows cannot be acted on. */
         for (i = 0; i < HM_NX; i++) {
