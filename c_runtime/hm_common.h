@@ -19,7 +19,7 @@
  * General (distance) rows touch only the position [px, py]. */
 #define HM_NX 4
 #define HM_NU 2
-#define HM_NP 2
+#define HM_NPOS 2
 
 /* What the OCP's QPs have (ocp_nlp_lin.c), which sizes a generated solver's QP memory
  * (ocp_qp_ipm_types.h: HM_NBP, HM_NGH): bounds on three components of (u, x), a and omega (u) and

@@ -69,29 +69,3 @@ HM_FUNC void ocp_nlp_start_clock(hm_solver *s, unsigned long long t_start)
     s->clock_fault = 0;
     s->deadline_ns = (unsigned long long)whole * 1000000ULL + frac_ns;
 }
-
-/* The collision potential f(d) = q / (1 + exp(kappa (d - d_th))) is below 1e-10 q beyond
- * d_th + ln(1e10) / kappa (its gradient kappa f and curvature kappa^2 f likewise, relative to kappa
- * and kappa^2): 5.6 m with the default kappa = 5, where f <= 5e-9 against goal terms of order 1 and a
- * QP tolerance of 1e-2 in the cost's units. People farther from a node than that are left out of its
- * cost (ocp_nlp_linearize, the line search's merit): with 100 people most of the 5,100 evaluations
- * of an RTI step, each with an exponential. Returns the squared reach (HM_INF: none left out). */
-HM_FUNC hm_real ocp_nlp_collision_reach2(const hm_params *p)
-{
-    const hm_real reach = p->d_th + HM_R(23.025850929940457) / p->kappa;
-    return p->kappa > HM_R(0.0) && reach < HM_R(1e6) ? reach * reach : HM_INF;
-}
-
-/* Node n's time against the collision potential's horizon, with half a period's slack so that a
- * horizon of k periods keeps node k whatever the rounding of k * dt. */
-HM_FUNC int ocp_nlp_collision_node(const hm_params *p, int n)
-{
-    return HM_R(HM_DT) * ((hm_real)n - HM_R(0.5)) <= p->collision_horizon;
-}
-
-/* 1 when the human at h is within the collision potential's reach (squared, above) of the node at x. */
-HM_FUNC int ocp_nlp_collision_near(const hm_real *x, const hm_real *h, hm_real reach2)
-{
-    const hm_real dx = x[0] - h[0], dy = x[1] - h[1];
-    return dx * dx + dy * dy <= reach2;
-}

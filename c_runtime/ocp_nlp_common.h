@@ -64,13 +64,4 @@ HM_FUNC int ocp_nlp_qp_usable(int status);
  * deadline is off by the caller's choice, hm_timing.h). */
 HM_FUNC int ocp_nlp_clock_fault(hm_solver *s, unsigned long long t_end);
 
-/* The collision potential's reach, squared (beyond it the potential is below 1e-10 q: ocp_nlp_common.c),
- * and whether a human at h is within it of the node at x. */
-HM_FUNC hm_real ocp_nlp_collision_reach2(const hm_params *p);
-HM_FUNC int ocp_nlp_collision_near(const hm_real *x, const hm_real *h, hm_real reach2);
-
-/* 1 when node n is within the collision potential's horizon (params collision_horizon): later nodes
- * carry no collision cost. */
-HM_FUNC int ocp_nlp_collision_node(const hm_params *p, int n);
-
 #endif /* OCP_NLP_COMMON_H */

@@ -100,13 +100,6 @@ HM_FUNC void ocp_nlp_init_braking(hm_solver *s, const hm_input *in)
     ocp_nlp_screen_reach(s);
 }
 
-HM_FUNC hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2)
-{
-    /* The slack a row needs at this point: s = max(0, -g). */
-    const hm_real sl = g < HM_R(0.0) ? -g : HM_R(0.0);
-    return l1 * sl + HM_R(0.5) * l2 * sl * sl;
-}
-
 /* Symmetric n x n M (column-major, n <= 6) replaced by its projection onto {eigenvalues >= floor}:
  * Jacobi sweeps over the upper triangle in round-robin order (each rotation zeroes its pair and moves the other
  * rows' two entries; Golub and Van Loan 8.5), then V max(Lambda, floor) V'. When every eigenvalue is
@@ -300,10 +293,9 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
 {
     const hm_params *p = &s->params;
     hm_ocp_qp *qp = &s->qp;
-    const int nh = ocp_nlp_clamp_humans(in);
-    const int ng = nh + (in->has_obstacle ? 1 : 0);
+    const ocp_nlp_terms t = ocp_nlp_cost_terms(p, in);
+    const int nh = t.nh, ng = t.ng;
     const hm_real reg = p->regularization;
-    const hm_real reach2 = ocp_nlp_collision_reach2(p);
     hm_real cost = HM_R(0.0), penalty = HM_R(0.0);
     int n, i, j;
 
@@ -312,7 +304,6 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
         hm_real *Q = qp->Q[n];
         hm_real *q = qp->q[n];
         hm_real l, far_h, far_o;
-        int nh_cost;
 
         if (n < HM_N) {
             if (s->dyn_fresh) {
@@ -324,7 +315,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
                 hm_model_dynamics(x, s->u[n], x_next, qp->A[n], qp->B[n]);
                 for (i = 0; i < HM_NX; i++) qp->b[n][i] = x_next[i] - s->x[n + 1][i];
             }
-            hm_model_cost_stage(x, s->u[n], ocp_nlp_goal_at(in, n), p->w_goal, p->w_control, &l, q, qp->r[n], Q, qp->R[n]);
+            l = ocp_nlp_cost_tracking(p, in, n, x, s->u[n], q, qp->r[n], Q, qp->R[n]);
             for (i = 0; i < HM_NU; i++) qp->R[n][i + i * HM_NU] += reg;
             for (i = 0; i < HM_NU * HM_NX; i++) qp->S[n][i] = HM_R(0.0);
             if (exact) {
@@ -339,34 +330,14 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
             qp->lbu[n][1] = p->omega_bounds[0] - s->u[n][1];
             qp->ubu[n][1] = p->omega_bounds[1] - s->u[n][1];
         } else {
-            hm_model_cost_terminal(x, ocp_nlp_goal_at(in, n), p->w_goal_terminal, &l, q, Q);
+            l = ocp_nlp_cost_tracking(p, in, n, x, 0, q, 0, Q, 0);
         }
         for (i = 0; i < HM_NX; i++) Q[i + i * HM_NX] += reg;
         cost += l;
 
-        /* Collision cost of each present human within its reach at its predicted position at this
-         * node: exact gradient, Gauss-Newton Hessian on the (px, py) block. */
-        /* the people whose potential this node carries: none beyond the potential's horizon */
-        nh_cost = ocp_nlp_collision_node(p, n) ? nh : 0;
-        for (j = 0; j < nh_cost; j++) {
-            hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP], hess_exact[HM_NP * HM_NP];
-            const hm_real *hess = hess_gn;
-            if (in->humans_no_potential[j] == 1 || !ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;
-            if (exact) {
-                hm_model_cost_collision(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn,
-                                        hess_exact);
-                hess = hess_exact;
-            } else {
-                hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
-            }
-            cost += f;
-            q[0] += grad[0];
-            q[1] += grad[1];
-            Q[0] += hess[0];
-            Q[1] += hess[1];
-            Q[HM_NX] += hess[2];
-            Q[HM_NX + 1] += hess[3];
-        }
+        /* Collision cost of each present person within reach at their predicted position at this
+         * node: exact gradient, Gauss-Newton (or exact) Hessian on the (px, py) block. */
+        cost = ocp_nlp_cost_people(p, in, &t, n, x, exact, cost, q, Q);
 
         /* Node 0 is the measured state: its bounds and rows cannot be acted on. */
         for (i = 0; i < HM_NX; i++) {
@@ -386,24 +357,20 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
         far_h = ocp_nlp_screen_far_reach(s, n, p->d_h);
         far_o = ocp_nlp_screen_far_reach(s, n, p->d_s);
         for (j = 0; j < ng; j++) {
-            const int human = j < nh;
-            const hm_real *c = human ? in->humans_now[j] : in->obstacle;
-            const hm_real *d_min = human ? &p->d_h : &p->d_s;
-            const hm_real l1 = human ? p->human_slack_l1 : p->slack_l1;
-            const hm_real l2 = human ? p->human_slack_l2 : p->slack_l2;
-            hm_real g, hess_d[HM_NP * HM_NP];
+            const ocp_nlp_row r = ocp_nlp_row_of(p, in, nh, j);
+            hm_real g, hess_d[HM_NPOS * HM_NPOS];
             qp->soft[n][j] = 1;
-            qp->zl[n][j] = l1;
-            qp->Zl[n][j] = l2;
+            qp->zl[n][j] = r.l1;
+            qp->Zl[n][j] = r.l2;
             /* beyond the screening radius by plain distance already: screened whatever its exact
              * margin, and not evaluated unless the QP's step could reach it (ocp_nlp_screen.c); with
              * the exact Hessian only without a multiplier, whose curvature it would carry */
-            if ((!exact || s->mult.lam_lg[n][j] == HM_R(0.0)) && ocp_nlp_screen_far(x, c, human ? far_h : far_o)) {
+            if ((!exact || s->mult.lam_lg[n][j] == HM_R(0.0)) && ocp_nlp_screen_far(x, r.c, j < nh ? far_h : far_o)) {
                 qp->D[n][j][0] = qp->D[n][j][1] = HM_R(0.0);
                 qp->lg[n][j] = -HM_INF;
                 continue;
             }
-            hm_model_distance_constraint(x, c, d_min, &g, qp->D[n][j], hess_d);
+            hm_model_distance_constraint(x, r.c, r.d_min, &g, qp->D[n][j], hess_d);
             if (exact) {
                 /* L = cost - lam (d - d_min + s): the row's curvature enters with -lam. */
                 const hm_real lam = s->mult.lam_lg[n][j];
@@ -413,7 +380,7 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact)
                 Q[HM_NX + 1] -= lam * hess_d[3];
             }
             qp->lg[n][j] = -g;
-            penalty += ocp_nlp_slack_penalty(g, l1, l2);
+            penalty += ocp_nlp_slack_penalty(g, r.l1, r.l2);
         }
     }
     s->dyn_fresh = 0;
@@ -447,13 +414,4 @@ HM_FUNC void ocp_nlp_set_x0(hm_solver *s, const hm_input *in)
     penalty = ocp_nlp_separation_penalty(s);
     s->cost += penalty;
     s->cost_slack += penalty;
-}
-
-HM_FUNC hm_real ocp_nlp_separation_penalty(const hm_solver *s)
-{
-    hm_real excess = HM_R(0.0);
-    int n;
-    if (!s->params.separation) return HM_R(0.0);
-    for (n = 1; n <= HM_N; n++) excess += hm_fmax(s->x[n][3] - s->v_separation[n], HM_R(0.0));
-    return s->params.human_slack_l1 * excess;
 }

@@ -4,7 +4,7 @@
 #ifndef OCP_NLP_LIN_H
 #define OCP_NLP_LIN_H
 
-#include "ocp_nlp_common.h"
+#include "ocp_nlp_cost.h"
 
 /* Initial guess of the next step: the previous plan shifted by one interval (the last control
  * repeated), re-simulated from the predicted state; or, cold, the controls held at zero from x0. */
@@ -15,9 +15,6 @@ HM_FUNC void ocp_nlp_init_braking(hm_solver *s, const hm_input *in);
 /* The guess moved into the bounds of a, omega and v and re-simulated (before a line-search RTI step). */
 HM_FUNC void ocp_nlp_project_guess(hm_solver *s);
 
-/* The cost of the slack that a row with value g needs (s = max(0, -g)), penalised by l1 and l2. */
-HM_FUNC hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2);
-
 /* Build the QP of the current iterate (everything but the initial-state offset) and the NLP
  * objective there; exact = 1: the Hessian of the Lagrangian at s->mult, projected onto the PSD cone
  * per stage, else Gauss-Newton. */
@@ -25,9 +22,5 @@ HM_FUNC void ocp_nlp_linearize(hm_solver *s, const hm_input *in, int exact);
 
 /* The measured state into the QP, as the offset of its fixed x_0 from the iterate's. */
 HM_FUNC void ocp_nlp_set_x0(hm_solver *s, const hm_input *in);
-
-/* The exact penalty (human_slack_l1) on the iterate's speeds above the speed-and-separation bounds
- * of the last ocp_nlp_set_x0; 0 without params.separation. */
-HM_FUNC hm_real ocp_nlp_separation_penalty(const hm_solver *s);
 
 #endif /* OCP_NLP_LIN_H */

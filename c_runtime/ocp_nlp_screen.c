@@ -5,6 +5,7 @@
  */
 #include "ocp_nlp_screen.h"
 
+#include "ocp_nlp_cost.h"
 #include "ocp_qp_ipm.h"
 
 /* ------------------------------------------------------------------------------------------------
@@ -62,11 +63,9 @@ HM_FUNC int ocp_nlp_screen_far(const hm_real *x, const hm_real *c, hm_real reach
  * the QP's D and, kept aside as a screened row's, its lg. */
 static void ocp_nlp_evaluate_row(hm_solver *s, const hm_input *in, int n, int j)
 {
-    const hm_params *p = &s->params;
-    const int human = j < ocp_nlp_clamp_humans(in);
-    hm_real g, hess_d[HM_NP * HM_NP];
-    hm_model_distance_constraint(s->x[n], human ? in->humans_now[j] : in->obstacle, human ? &p->d_h : &p->d_s, &g,
-                                 s->qp.D[n][j], hess_d);
+    const ocp_nlp_row r = ocp_nlp_row_of(&s->params, in, ocp_nlp_clamp_humans(in), j);
+    hm_real g, hess_d[HM_NPOS * HM_NPOS];
+    hm_model_distance_constraint(s->x[n], r.c, r.d_min, &g, s->qp.D[n][j], hess_d);
     s->screened_lg[n][j] = -g;
 }
 

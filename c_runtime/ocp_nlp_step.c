@@ -6,6 +6,7 @@
  */
 #include "ocp_nlp_step.h"
 
+#include "ocp_nlp_cost.h"
 #include "ocp_nlp_lin.h"
 #include "ocp_nlp_screen.h"
 
@@ -40,51 +41,21 @@ HM_FUNC int ocp_nlp_qp_step(hm_solver *s, const hm_input *in, int shifted, int *
     return status;
 }
 
-/* l1 merit of the iterate: objective with the soft-row penalties + mu * (|dynamics gaps|_1 +
- * |x_0 - measured x0|_1). Bounds are linear, so every step of the line search keeps those its base
- * kept; the speed-and-separation bounds, which move with the iterate, count with their excess. */
+/* l1 merit of the iterate: the objective with the soft-row penalties (ocp_nlp_objective) + mu *
+ * (|dynamics gaps|_1 + |x_0 - measured x0|_1). Bounds are linear, so every step of the line search
+ * keeps those its base kept; the speed-and-separation bounds, which move with the iterate, count with
+ * their excess. */
 static hm_real ocp_nlp_merit(const hm_solver *s, const hm_input *in, hm_real mu)
 {
-    const hm_params *p = &s->params;
-    const int nh = ocp_nlp_clamp_humans(in);
-    const int ng = nh + (in->has_obstacle ? 1 : 0);
-    const hm_real reach2 = ocp_nlp_collision_reach2(p);
-    hm_real merit = HM_R(0.0), gaps = HM_R(0.0);
-    int n, i, j;
+    hm_real gaps = HM_R(0.0);
+    int n, i;
     for (i = 0; i < HM_NX; i++) gaps += hm_fabs(s->x[0][i] - in->x0[i]);
-    for (n = 0; n <= HM_N; n++) {
-        const hm_real *x = s->x[n];
-        hm_real l, gx[HM_NX], hx[HM_NX * HM_NX];
-        int nh_cost;
-        if (n < HM_N) {
-            hm_real gu[HM_NU], hu[HM_NU * HM_NU], x_next[HM_NX], A[HM_NX * HM_NX], B[HM_NX * HM_NU];
-            hm_model_dynamics(x, s->u[n], x_next, A, B);
-            for (i = 0; i < HM_NX; i++) gaps += hm_fabs(x_next[i] - s->x[n + 1][i]);
-            hm_model_cost_stage(x, s->u[n], ocp_nlp_goal_at(in, n), p->w_goal, p->w_control, &l, gx, gu, hx, hu);
-        } else {
-            hm_model_cost_terminal(x, ocp_nlp_goal_at(in, n), p->w_goal_terminal, &l, gx, hx);
-        }
-        merit += l;
-        /* the people whose potential this node carries: none beyond the potential's horizon */
-        nh_cost = ocp_nlp_collision_node(p, n) ? nh : 0;
-        for (j = 0; j < nh_cost; j++) {
-            hm_real f, grad[HM_NP], hess_gn[HM_NP * HM_NP];
-            /* as the linearisation */
-            if (in->humans_no_potential[j] == 1 || !ocp_nlp_collision_near(x, in->humans_pred[n][j], reach2)) continue;
-            hm_model_cost_collision_gn(x, in->humans_pred[n][j], &p->q, &p->d_th, &p->kappa, &f, grad, hess_gn);
-            merit += f;
-        }
-        if (n == 0) continue;
-        for (j = 0; j < ng; j++) {
-            const int human = j < nh;
-            hm_real g, jac[HM_NP], hess_d[HM_NP * HM_NP];
-            hm_model_distance_constraint(x, human ? in->humans_now[j] : in->obstacle, human ? &p->d_h : &p->d_s,
-                                         &g, jac, hess_d);
-            merit += ocp_nlp_slack_penalty(g, human ? p->human_slack_l1 : p->slack_l1,
-                                           human ? p->human_slack_l2 : p->slack_l2);
-        }
+    for (n = 0; n < HM_N; n++) {
+        hm_real x_next[HM_NX], A[HM_NX * HM_NX], B[HM_NX * HM_NU];
+        hm_model_dynamics(s->x[n], s->u[n], x_next, A, B);
+        for (i = 0; i < HM_NX; i++) gaps += hm_fabs(x_next[i] - s->x[n + 1][i]);
     }
-    return merit + ocp_nlp_separation_penalty(s) + mu * gaps;
+    return ocp_nlp_objective(s, in) + mu * gaps;
 }
 
 /* Full SQP step with a backtracking line search on the l1 merit (Armijo on the decrease that the

@@ -16,7 +16,7 @@ HM_FUNC void ocp_qp_set_zero(hm_ocp_qp *qp)
         }
         qp->ng[n] = 0;
         for (i = 0; i < HM_NG; i++) {
-            for (j = 0; j < HM_NP; j++) qp->D[n][i][j] = HM_R(0.0);
+            for (j = 0; j < HM_NPOS; j++) qp->D[n][i][j] = HM_R(0.0);
             qp->lg[n][i] = -HM_INF;
             qp->soft[n][i] = 0;
             qp->zl[n][i] = HM_R(0.0);
@@ -116,7 +116,7 @@ HM_FUNC int ocp_qp_check(const hm_ocp_qp *qp)
         if (qp->ng[n] < 0 || qp->ng[n] > HM_NG) return HM_QP_NONFINITE;
         for (i = 0; i < qp->ng[n]; i++) {
             if (qp->lg[n][i] == -HM_INF) continue;   /* absent: no solver reads it (most rows of a screened QP) */
-            if (!ocp_qp_all_finite(qp->D[n][i], HM_NP) || isnan(qp->lg[n][i])) return HM_QP_NONFINITE;
+            if (!ocp_qp_all_finite(qp->D[n][i], HM_NPOS) || isnan(qp->lg[n][i])) return HM_QP_NONFINITE;
             if (qp->soft[n][i] && (!isfinite(qp->zl[n][i]) || !isfinite(qp->Zl[n][i])))
                 return HM_QP_NONFINITE;
         }

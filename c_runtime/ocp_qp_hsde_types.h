@@ -64,7 +64,7 @@ typedef struct HM_NS(ocp_qp_hsde_ws) {
     HM_REAL box_sign[HM_N + 1][HM_TYPES_HSDE_NB_];          /* +1 upper bound, -1 lower bound */
     unsigned char row_idx[HM_TYPES_HSDE_NGR_];   /* QP row i of the k-th general row */
     unsigned char soft_of[HM_TYPES_HSDE_NRC_];   /* k of the j-th soft row */
-    HM_REAL D[HM_TYPES_HSDE_NGR_][HM_NP];        /* D of the k-th general row */
+    HM_REAL D[HM_TYPES_HSDE_NGR_][HM_NPOS];        /* D of the k-th general row */
     HM_REAL soft_Zl[HM_TYPES_HSDE_NRC_];         /* Zl of the j-th soft row, times cost_scale */
     /* the data of the embedding: cost gradient q and right-hand sides b (dynamics, inequality rows),
      * with the terms of the fixed x_0 moved into stage 0 */

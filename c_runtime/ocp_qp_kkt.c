@@ -11,7 +11,7 @@
  * 2x4 block Kx = L^-1 (S + B' P A) and the Schur complement P_n = (Q + A' P A) - Kx' D^-1 Kx. LDL'
  * rather than Cholesky: no square root on the recursion's critical path.
  *
- * The kernels are written for the fixed sizes (HM_NU = HM_NP = 2, HM_NX = 4): loops have
+ * The kernels are written for the fixed sizes (HM_NU = HM_NPOS = 2, HM_NX = 4): loops have
  * compile-time bounds and products are in axpy form over contiguous columns (2-wide SIMD).
  */
 #include "ocp_qp_kkt.h"

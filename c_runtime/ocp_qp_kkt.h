@@ -65,7 +65,7 @@
 #define HM_QP_HB(n) (HM_QP_NGH > 0 ? (n) : 0)
 
 /* The 2x2 input block and the (px, py) rows are written out for these sizes. */
-typedef char ocp_qp_kkt_sizes_fixed[(HM_NU == 2 && HM_NX == 4 && HM_NP == 2 && HM_NG <= 255) ? 1 : -1];
+typedef char ocp_qp_kkt_sizes_fixed[(HM_NU == 2 && HM_NX == 4 && HM_NPOS == 2 && HM_NG <= 255) ? 1 : -1];
 
 /* Stage n of the factorisation: the stage matrix (the QP's cost Hessian times the cost scale c,
  * sn->Hd, sn->Hpp and, for n < HM_N, the cost-to-go sn1->P of stage n + 1) and its partial LDL' over

@@ -40,7 +40,7 @@ typedef struct HM_NS(ocp_qp) {
     HM_REAL lbu[HM_N][HM_NU];
     HM_REAL ubu[HM_N][HM_NU];
     int ng[HM_N + 1];
-    HM_REAL D[HM_N + 1][HM_NG][HM_NP];
+    HM_REAL D[HM_N + 1][HM_NG][HM_NPOS];
     HM_REAL lg[HM_N + 1][HM_NG];
     int soft[HM_N + 1][HM_NG];
     HM_REAL zl[HM_N + 1][HM_NG];

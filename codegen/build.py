@@ -12,34 +12,23 @@ import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
-from .generate import MANIFEST
+from .manifest import Manifest, ManifestError
 
 
 class BuildError(RuntimeError):
     """The C compiler or make failed; the message carries the end of their output."""
 
 
-def read_manifest(solver_dir: Path) -> dict[str, object]:
-    path = solver_dir / MANIFEST
-    if not solver_dir.exists():
-        raise BuildError(f"{solver_dir} does not exist: give the folder `humanmpc-gen generate` wrote "
-                         "(by default generated/<name>)")
-    if not solver_dir.is_dir():
-        raise BuildError(f"{solver_dir} is a file, not a folder: give the folder `humanmpc-gen generate` wrote")
-    if not path.is_file():
-        raise BuildError(f"{solver_dir} is not a generated humanmpc solver: {MANIFEST} is missing")
+def read_manifest(solver_dir: Path) -> Manifest:
     try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError) as err:
-        raise BuildError(f"{path} cannot be read as a manifest ({err}): generate the package again") from None
-    if not isinstance(data, dict):
-        raise BuildError(f"{path} is not a manifest (not a JSON object): generate the package again")
-    return data
+        return Manifest.read(solver_dir)
+    except ManifestError as err:
+        raise BuildError(str(err)) from None
 
 
 def library_path(solver_dir: str | Path) -> Path:
     d = Path(solver_dir)
-    return d / str(read_manifest(d)["library"])
+    return d / read_manifest(d).library
 
 
 def is_stale(solver_dir: Path) -> bool:

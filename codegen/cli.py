@@ -94,20 +94,18 @@ def solver_memory(lib: Path, name: str) -> list[tuple[str, int]]:
 def _cmd_info(args: argparse.Namespace) -> int:
     d: Path = args.dir
     m = read_manifest(d)
-    dims = m["dims"]
-    assert isinstance(dims, dict)
-    print(f"solver '{m['name']}'  (humanmpc {m['generator_version']}, CasADi {m['casadi_version']}, {m['real']})")
-    print(f"  spec sha256  {m['spec_hash']}")
-    print(f"  sizes        N={dims['N']} intervals of dt={dims['dt']:g} s (T={dims['T']:g} s), "
-          f"N_h={dims['nh']} humans, {dims['ng']} distance rows/node, nx={dims['nx']}, nu={dims['nu']}")
-    if "qp_rows" in dims:
-        print(f"  QP rows      at most {dims['qp_rows']} distance rows in one QP (solver.qp_rows; of "
-              f"{(int(dims['N']) + 1) * int(dims['ng'])} in all)")
+    dims = m.dims
+    print(f"solver '{m.name}'  (humanmpc {m.generator_version}, CasADi {m.casadi_version}, {m.real})")
+    print(f"  spec sha256  {m.spec_hash}")
+    print(f"  sizes        N={dims.N} intervals of dt={dims.dt:g} s (T={dims.T:g} s), "
+          f"N_h={dims.nh} humans, {dims.ng} distance rows/node, nx={dims.nx}, nu={dims.nu}")
+    print(f"  QP rows      at most {dims.qp_rows} distance rows in one QP (solver.qp_rows; of "
+          f"{(dims.N + 1) * dims.ng} in all)")
     print("  files")
     for p in sorted(d.rglob("*")):
         if p.is_file() and "build" not in p.relative_to(d).parts[:-1]:
             print(f"    {p.relative_to(d)!s:<28} {p.stat().st_size:>9,} B")
-    lib = d / str(m["library"])
+    lib = d / m.library
     print(f"  library      {lib} ({lib.stat().st_size:,} B)" if lib.exists() else "  library      not built")
     if lib.exists():
         flags = built_flags(d)
@@ -120,20 +118,18 @@ def _cmd_info(args: argparse.Namespace) -> int:
             print(f"  built with   {flags}  ({kind})")
     if lib.exists():
         print("  static memory (the structs a caller declares; nothing is allocated at run time)")
-        for what, size in static_memory(lib, str(m["name"])):
+        for what, size in static_memory(lib, m.name):
             print(f"    {what:<34} {size:>11,} B")
-        parts = solver_memory(lib, str(m["name"]))
+        parts = solver_memory(lib, m.name)
         if parts:
-            print(f"  {m['name']}_solver by part")
+            print(f"  {m.name}_solver by part")
             for what, size in parts:
                 print(f"    {what:<44} {size:>11,} B")
-    functions = m["functions"]
-    assert isinstance(functions, list)
     print("  model functions (C and Python)")
-    for f in functions:
-        ins = ", ".join(n for n, _, _ in f["inputs"])
-        outs = ", ".join(n for n, _, _ in f["outputs"])
-        print(f"    {m['name']}_{f['name']}({ins}) -> {outs}")
+    for f in m.functions:
+        ins = ", ".join(p.name for p in f.inputs)
+        outs = ", ".join(p.name for p in f.outputs)
+        print(f"    {m.name}_{f.name}({ins}) -> {outs}")
     return 0
 
 

@@ -6,7 +6,6 @@ any point leaves no half-written output behind.
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
 import sys
@@ -18,6 +17,7 @@ import casadi as ca
 
 from . import __version__
 from .casadi_emit import emit_model
+from .manifest import MANIFEST, Dims, Manifest, ModelFunctionInfo, Port, StatusRow
 from .ocp import OcpModel
 from .params import PARAMS, spec_params
 from .render import render_all, template_context
@@ -25,14 +25,12 @@ from .resources import check_resources, runtime_files
 from .spec import Spec, resolve_spec
 from .status import status_tables
 
-MANIFEST = "manifest.json"
-
 
 class GenerateError(RuntimeError):
     """The output folder could not be written (the spec itself was fine)."""
 
 
-def _populate(spec: Spec, out: Path) -> dict[str, object]:
+def _populate(spec: Spec, out: Path) -> Manifest:
     real = spec.precision
     model = OcpModel(spec)
     emitted = emit_model(model.functions, spec.name, real, out)
@@ -47,40 +45,26 @@ def _populate(spec: Spec, out: Path) -> dict[str, object]:
         f"# resolved spec of the humanmpc solver \"{spec.name}\" (sha256 {spec.digest()})\n" + spec.to_yaml()
     )
     defaults = spec_params(spec)
-    manifest: dict[str, object] = {
-        "generator": "humanmpc",
-        "generator_version": __version__,
-        "casadi_version": ca.CasadiMeta.version(),
-        "name": spec.name,
-        "spec_hash": spec.digest(),
-        "real": real,
-        "dims": {
-            "nx": context["nx"],
-            "nu": context["nu"],
-            "N": context["N"],
-            "nh": context["NH"],
-            "ng": context["NG"],
-            "qp_rows": context["QP_ROWS"],
-            "dt": spec.dt,
-            "T": spec.horizon.T,
-        },
-        "functions": [
-            {
-                "name": ef.model.name,
-                "doc": ef.model.doc,
-                "inputs": [[p.name, p.rows, p.cols] for p in ef.model.inputs],
-                "outputs": [[p.name, p.rows, p.cols] for p in ef.model.outputs],
-            }
+    manifest = Manifest(
+        generator="humanmpc",
+        generator_version=__version__,
+        casadi_version=ca.CasadiMeta.version(),
+        name=spec.name,
+        spec_hash=spec.digest(),
+        real=real,
+        dims=Dims(nx=context["nx"], nu=context["nu"], N=context["N"], nh=context["NH"], ng=context["NG"],
+                  qp_rows=context["QP_ROWS"], dt=spec.dt, T=spec.horizon.T),
+        functions=tuple(
+            ModelFunctionInfo(ef.model.name, ef.model.doc, tuple(Port(p.name, p.rows, p.cols) for p in ef.model.inputs),
+                              tuple(Port(p.name, p.rows, p.cols) for p in ef.model.outputs))
             for ef in emitted
-        ],
-        "library": f"build/lib{spec.name}.so",
-        # the runtime parameters' table (humanmpc.codegen.params) with this solver's defaults: what
-        # a binding checks set_params against
-        "params": [{**p.manifest_row(), "default": defaults[p.name]} for p in PARAMS],
-        # status codes and stop reasons (runtime/hm_status.h): value, name, message
-        "statuses": {key: [[c.value, c.name, c.message] for c in rows] for key, rows in status_tables().items()},
-    }
-    (out / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n")
+        ),
+        library=f"build/lib{spec.name}.so",
+        params=tuple({**p.manifest_row(), "default": defaults[p.name]} for p in PARAMS),
+        statuses={key: tuple(StatusRow(c.value, c.name, c.message) for c in rows)
+                  for key, rows in status_tables().items()},
+    )
+    manifest.write(out)
     return manifest
 
 

@@ -20,7 +20,7 @@ from .spec import Spec
 
 NX = 4
 NU = 2
-NP = 2  # the distance rows and the collision cost touch only the position [px, py]
+NPOS = 2  # the distance rows and the collision cost touch only the position [px, py]
 
 # Distances are smoothed as sqrt(dx^2 + dy^2 + eps^2): differentiable at 0 with a zero gradient
 # there, and off by eps^2 / (2 d) <= 1e-6 m at d >= 0.5 m.
@@ -118,8 +118,8 @@ class OcpModel:
         x = ca.SX.sym("x", NX)
         u = ca.SX.sym("u", NU)
         g = ca.SX.sym("g", NX)
-        p = ca.SX.sym("p", NP)
-        c = ca.SX.sym("c", NP)
+        p = ca.SX.sym("p", NPOS)
+        c = ca.SX.sym("c", NPOS)
         w_goal = ca.SX.sym("w_goal", NX)
         w_control = ca.SX.sym("w_control", NU)
         w_terminal = ca.SX.sym("w_goal_terminal", NX)
@@ -199,7 +199,7 @@ class OcpModel:
         inv_dist = reciprocal(dist)
         grad_d = (p - c) * inv_dist
         f_val, f_d, f_dd = collision_potential_derivatives(dist, q, d_th, kappa)
-        hess_d = (ca.SX.eye(NP) - grad_d @ grad_d.T) * inv_dist
+        hess_d = (ca.SX.eye(NPOS) - grad_d @ grad_d.T) * inv_dist
         hess_gn = f_dd * (grad_d @ grad_d.T)
         collision_in = [("p", p), ("h", c), ("q", q), ("d_th", d_th), ("kappa", kappa)]
         collision_gn_out = [("f", f_val), ("grad_p", f_d * grad_d), ("hess_gn_p", hess_gn)]

@@ -28,7 +28,7 @@ Constraints ``g(w)`` (NG rows), in blocks:
 Bounds: v in bounds.v at n = 1..N, a and omega in their bounds, s >= 0. A row or bound that does not
 apply is written as +-INF = 1e20, which Ipopt reads as infinite (its nlp_*_bound_inf is 1e19).
 
-Parameter vector ``p`` (NP entries): one step's inputs and the runtime parameters, see
+Parameter vector ``p`` (N_PARAM entries): one step's inputs and the runtime parameters, see
 ``ParamLayout``. The C program (templates/ipopt_reference.c.j2) receives it per step from the replay
 file and never needs to know its layout, except x0 at offset 0 (warm start).
 """
@@ -241,7 +241,7 @@ class ReferenceNlp:
         self.N, self.NH = N, NH
         self.params = ParamLayout(N, NH)
         self.decision = DecisionLayout(N)
-        NW, NP = self.decision.size, self.params.size
+        NW, N_PARAM = self.decision.size, self.params.size
         uo, so = self.decision.u_offset, self.decision.s_offset
         dt, steps = spec.dt, spec.integrator.steps
 
@@ -300,7 +300,7 @@ class ReferenceNlp:
 
         # ---- the NLP in MX over the whole horizon ------------------------------------------------
         w = ca.MX.sym("w", NW)
-        p = ca.MX.sym("p", NP)
+        p = ca.MX.sym("p", N_PARAM)
         P = self.params.split(p)
         X = ca.reshape(w[:uo], NX, N + 1)
         U = ca.reshape(w[uo:so], NU, N)
@@ -365,7 +365,7 @@ class ReferenceNlp:
             assert sp.is_dense() and sp.numel() == len(rows), f"{fn.name()}: values and pattern disagree"
 
         # ---- bounds and the cold start, SX functions of p ---------------------------------------
-        ps = ca.SX.sym("p", NP)
+        ps = ca.SX.sym("p", N_PARAM)
         Ps = self.params.split(ps)
         active_s, has_obstacle = Ps["human_active"], Ps["has_obstacle"]
         vb, ab, ob = Ps["v_bounds"], Ps["a_bounds"], Ps["omega_bounds"]
@@ -396,7 +396,7 @@ class ReferenceNlp:
         # ---- common evaluation of other solvers' plans -------------------------------------------
         # The objective with each slack at its smallest feasible value s_n = max(0, d_s - d(p_n, o))
         # (0 without an obstacle).
-        Xm, Um, pm = ca.MX.sym("X", N + 1, NX), ca.MX.sym("U", N, NU), ca.MX.sym("p", NP)
+        Xm, Um, pm = ca.MX.sym("X", N + 1, NX), ca.MX.sym("U", N, NU), ca.MX.sym("p", N_PARAM)
         Pm = self.params.split(pm)
         dist_o = obstacle_row.map(N)(Xm[1:, :].T, Pm["obstacle"], 0)
         s_min = Pm["has_obstacle"] * ca.fmax(0, Pm["d_s"] - dist_o)
@@ -468,7 +468,7 @@ class ReferenceNlp:
         return self.decision.size
 
     @property
-    def np(self) -> int:
+    def n_param(self) -> int:
         return self.params.size
 
     def generated_functions(self) -> list[ca.Function]:
@@ -477,7 +477,7 @@ class ReferenceNlp:
     def nlp_solver(self, tol: float = 1e-10, max_iter: int = 3000, print_level: int = 0) -> ca.Function:
         """CasADi's own Ipopt on the same NLP, with CasADi's own derivatives (the cross-check of the C program)."""
         w = ca.MX.sym("w", self.nw)
-        p = ca.MX.sym("p", self.np)
+        p = ca.MX.sym("p", self.n_param)
         nlp = {"x": w, "p": p, "f": self.f(w, p), "g": self.g(w, p)}
         return ca.nlpsol("reference", "ipopt", nlp, {
             "print_time": False,
@@ -506,7 +506,7 @@ class GeneratedNlp:
     prefix: str
     nw: int
     ng: int
-    np: int
+    n_param: int
     jac_rows: list[int]
     jac_cols: list[int]
     hess_rows: list[int]
@@ -549,7 +549,7 @@ def generate_c(nlp: ReferenceNlp, prefix: str, out_dir: Path) -> GeneratedNlp:
     hr, hc = nlp.hess_pattern
     assert all(r >= c for r, c in zip(hr, hc, strict=True)), "Hessian pattern must be the lower triangle"
     return GeneratedNlp(
-        c_file=c_file, h_file=out_dir / f"{prefix}.h", prefix=prefix, nw=nlp.nw, ng=nlp.ng, np=nlp.np,
+        c_file=c_file, h_file=out_dir / f"{prefix}.h", prefix=prefix, nw=nlp.nw, ng=nlp.ng, n_param=nlp.n_param,
         jac_rows=jr, jac_cols=jc, hess_rows=hr, hess_cols=hc,
         sz_arg=sz["arg"], sz_res=sz["res"], sz_iw=sz["iw"], sz_w=sz["w"],
     )

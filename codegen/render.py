@@ -42,6 +42,7 @@ RUNTIME_SOURCES = (
     "ocp_qp_ipm.c",
     "ocp_nlp_common.c",
     "monitor.c",
+    "ocp_nlp_cost.c",
     "ocp_nlp_lin.c",
     "ocp_nlp_screen.c",
     "ocp_nlp_step.c",
@@ -176,7 +177,7 @@ def template_context(spec: Spec, functions: list[EmittedFunction], real: str) ->
         "QP_ROWS": int(spec.qp_row_capacity),
         "NH_ALLOC": max(1, int(spec.humans.max)),  # C has no zero-length arrays
         "NT": int(spec.controller.max_tracks),
-        "NP": int(spec.controller.max_path_points),
+        "MAX_PATH_POINTS": int(spec.controller.max_path_points),
         "NK": int(spec.controller.max_obstacle_points),
         "NC": int(spec.controller.candidates),
         "runtime_sources": RUNTIME_SOURCES,

@@ -242,9 +242,9 @@ def solver_spec(solver_dir: Path) -> Spec:
         spec = load_spec(spec_file)
     except SpecError as err:
         raise GenerateError(f"{spec_file}: {err}") from None
-    if manifest.get("spec_hash") != spec.digest():
+    if manifest.spec_hash != spec.digest():
         raise GenerateError(f"{spec_file} does not hold the spec of {solver_dir / 'manifest.json'} (spec_hash "
-                            f"{manifest.get('spec_hash')}, spec.yaml's {spec.digest()}): regenerate the solver")
+                            f"{manifest.spec_hash}, spec.yaml's {spec.digest()}): regenerate the solver")
     return spec
 
 

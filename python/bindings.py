@@ -8,10 +8,8 @@ against the package's manifest before anything is called.
 
 from __future__ import annotations
 
-import json
 from collections import namedtuple
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -20,26 +18,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .codegen.build import LibraryIntegrityError, build, check_library, is_stale
+from .codegen.manifest import MANIFEST, Manifest, ManifestError, ManifestMissingError, ModelFunctionInfo
+from .codegen.manifest import Dims as Dims
 from .codegen.params import Param
-from .codegen.spec import IDENT_RE
 from .solver import Solver
+from .status import check_package_tables, status_enums
 
 FloatArray = NDArray[np.float64]
 
 
 class LoadError(RuntimeError):
     """A generated solver folder that cannot be loaded (missing, stale, or not matching its library)."""
-
-
-@dataclass(frozen=True)
-class Dims:
-    nx: int
-    nu: int
-    N: int
-    nh: int
-    ng: int
-    dt: float
-    T: float
 
 
 def _as_input(fn: str, port: str, value: ArrayLike, shape: tuple[int, ...], dtype: Any = np.float64) -> Any:
@@ -54,17 +43,18 @@ def _as_input(fn: str, port: str, value: ArrayLike, shape: tuple[int, ...], dtyp
 class ModelFunction:
     """One generated model function, callable on numpy arrays; returns a named tuple of outputs."""
 
-    def __init__(self, ffi: cffi.FFI, cfunc: Callable[..., int], meta: dict[str, Any], real: str = "double") -> None:
+    def __init__(self, ffi: cffi.FFI, cfunc: Callable[..., int], meta: ModelFunctionInfo, real: str = "double") -> None:
         self._ffi = ffi
         self._cfunc = cfunc
         self._ctype = f"{real}[]"  # buffers of the solver's real type; results are returned as float64
         self._dtype = np.dtype(np.float32 if real == "float" else np.float64)
-        self.name: str = meta["name"]
-        self.__doc__ = meta["doc"]
+        self.name: str = meta.name
+        self.__doc__ = meta.doc
         self.inputs: list[tuple[str, tuple[int, ...]]] = [
-            (n, () if (r, c) == (1, 1) else (r,) if c == 1 else (r, c)) for n, r, c in meta["inputs"]
+            (p.name, () if (p.rows, p.cols) == (1, 1) else (p.rows,) if p.cols == 1 else (p.rows, p.cols))
+            for p in meta.inputs
         ]
-        self.outputs: list[tuple[str, tuple[int, int]]] = [(n, (r, c)) for n, r, c in meta["outputs"]]
+        self.outputs: list[tuple[str, tuple[int, int]]] = [(p.name, (p.rows, p.cols)) for p in meta.outputs]
         self._result: Any = namedtuple(f"{self.name}_result", [n for n, _ in self.outputs])  # type: ignore[misc]
 
     def __call__(self, *args: ArrayLike) -> Any:
@@ -107,24 +97,22 @@ class ModelFunctions:
 def load(solver_dir: str | Path, *, build_if_needed: bool = True) -> Solver:
     """Load the generated solver in ``solver_dir`` (compiling it first when its library is stale)."""
     d = Path(solver_dir).resolve()
-    manifest_path = d / "manifest.json"
-    if not manifest_path.is_file():
-        raise LoadError(f"{d} is not a generated humanmpc solver (no manifest.json); run `humanmpc-gen generate`")
     try:
-        manifest = json.loads(manifest_path.read_text())
-        name = manifest["name"]
-    except (OSError, ValueError, KeyError, TypeError) as err:
-        raise LoadError(f"{manifest_path} is not a humanmpc manifest ({err!r}); regenerate the package") from None
-    if not isinstance(name, str) or not IDENT_RE.fullmatch(name):
-        raise LoadError(f"{d}: the manifest's name {name!r} is not a C identifier; regenerate the package")
+        manifest = Manifest.read(d)
+    except ManifestMissingError:
+        raise LoadError(f"{d} is not a generated humanmpc solver (no {MANIFEST}); "
+                        "run `humanmpc-gen generate`") from None
+    except ManifestError as err:
+        raise LoadError(str(err)) from None
+    name = manifest.name
     if is_stale(d):
         if not build_if_needed:
             raise LoadError(f"{d}: the library is missing or older than its sources; run `humanmpc-gen build {d}`")
         build(d)
     # the library is the package's own: a manifest may not point anywhere else
-    lib_path = (d / str(manifest["library"])).resolve()
+    lib_path = (d / manifest.library).resolve()
     if not lib_path.is_relative_to(d) or lib_path.suffix != ".so":
-        raise LoadError(f"{d}: the manifest's library {manifest['library']!r} is not a .so inside the package")
+        raise LoadError(f"{d}: the manifest's library {manifest.library!r} is not a .so inside the package")
     ffi = cffi.FFI()
     try:
         ffi.cdef((d / f"{name}_cffi.h").read_text())
@@ -138,13 +126,13 @@ def load(solver_dir: str | Path, *, build_if_needed: bool = True) -> Solver:
         raise LoadError(f"{d}: {err}") from None
     lib = ffi.dlopen(str(lib_path))
     got_hash = ffi.string(getattr(lib, f"{name}_spec_hash")()).decode()
-    if got_hash != manifest["spec_hash"]:
+    if got_hash != manifest.spec_hash:
         raise LoadError(f"{d}: the library was built from spec {got_hash[:12]}, the folder holds "
-                        f"{manifest['spec_hash'][:12]}; rebuild it")
+                        f"{manifest.spec_hash[:12]}; rebuild it")
     sizes = ffi.new("int[5]")
     getattr(lib, f"{name}_dims")(sizes + 0, sizes + 1, sizes + 2, sizes + 3, sizes + 4)
-    m = manifest["dims"]
-    if list(sizes) != [m["nx"], m["nu"], m["N"], m["nh"], m["ng"]]:
+    m = manifest.dims
+    if list(sizes) != [m.nx, m.nu, m.N, m.nh, m.ng]:
         raise LoadError(f"{d}: library sizes {list(sizes)} do not match the manifest")
     # the declarations cffi writes through must be the compiled structs, byte for byte in size
     compiled = ffi.new("size_t[3]")
@@ -153,14 +141,15 @@ def load(solver_dir: str | Path, *, build_if_needed: bool = True) -> Solver:
     if list(compiled) != declared:
         raise LoadError(f"{d}: {name}_cffi.h declares params/input/output of {declared} bytes, the library "
                         f"was compiled with {list(compiled)}: regenerate and rebuild the package")
-    m = manifest["dims"]
-    dims_obj = Dims(nx=m["nx"], nu=m["nu"], N=m["N"], nh=m["nh"], ng=m["ng"], dt=m["dt"], T=m["T"])
     model = ModelFunctions(
-        {f["name"]: ModelFunction(ffi, getattr(lib, f"{name}_{f['name']}"), f, manifest.get("real", "double"))
-         for f in manifest["functions"]}
+        {f.name: ModelFunction(ffi, getattr(lib, f"{name}_{f.name}"), f, manifest.real) for f in manifest.functions}
     )
-    if "params" not in manifest:
-        raise LoadError(f"{d} was generated by humanmpc {manifest.get('generator_version', '?')}, whose manifest "
-                        "has no parameter table: regenerate it with `humanmpc-gen generate --force`")
-    table = tuple(Param.from_manifest_row(row) for row in manifest["params"])
-    return Solver(name, dims_obj, ffi, lib, model, d, manifest["spec_hash"], table)
+    table = tuple(Param.from_manifest_row(row) for row in manifest.params)
+    try:
+        check_package_tables(manifest.statuses, str(d))
+        statuses = status_enums(manifest.statuses, str(d))
+    except ValueError as err:
+        raise LoadError(str(err)) from None
+    solver = Solver(name, manifest.dims, ffi, lib, model, d, manifest.spec_hash, table)
+    solver.statuses = statuses  # the package's own enums (its manifest's tables)
+    return solver

@@ -21,6 +21,7 @@ from .codegen.params import Param
 from .controller import Controller
 from .results import StepResult, c_array_view, record_dtype
 from .runtime_params import RuntimeParams
+from .status import StatusEnums
 from .steplog import StepLog
 
 
@@ -34,6 +35,7 @@ class Solver:
         self.model = model
         self.path = path
         self.spec_hash = spec_hash
+        self.statuses: StatusEnums | None = None  # the package's status enums (humanmpc.load sets them)
         self._ffi = ffi
         self._lib = lib
         fn = lambda suffix: getattr(lib, f"{name}_{suffix}")  # noqa: E731

@@ -19,7 +19,7 @@ import cffi
 import numpy as np
 import scipy.sparse as sp
 
-NX, NU, NP = 4, 2, 2
+NX, NU, NPOS = 4, 2, 2
 NUX = NU + NX
 HM_INF = 1e30
 REPO = Path(__file__).resolve().parent.parent
@@ -600,7 +600,7 @@ def empty_qp(N: int, NG: int) -> QP:
         S=np.zeros((N, NU, NX)), R=np.zeros((N, NU, NU)), q=np.zeros((N + 1, NX)), r=np.zeros((N, NU)),
         x0=np.zeros(NX), lbx=np.full((N + 1, NX), -HM_INF), ubx=np.full((N + 1, NX), HM_INF),
         lbu=np.full((N, NU), -HM_INF), ubu=np.full((N, NU), HM_INF), ng=np.zeros(N + 1, dtype=np.int32),
-        D=np.zeros((N + 1, NG, NP)), lg=np.zeros((N + 1, NG)), soft=np.zeros((N + 1, NG), dtype=np.int32),
+        D=np.zeros((N + 1, NG, NPOS)), lg=np.zeros((N + 1, NG)), soft=np.zeros((N + 1, NG), dtype=np.int32),
         zl=np.zeros((N + 1, NG)), Zl=np.zeros((N + 1, NG)),
     )
 
@@ -693,12 +693,12 @@ def _garbage_unused(rng: np.random.Generator, qp: QP) -> None:
     junk = lambda shape: rng.choice([np.nan, np.inf, -1e300, 7.0], size=shape)  # noqa: E731
     qp.lbx[0] = junk(NX)
     qp.ubx[0] = junk(NX)
-    qp.D[0] = junk((qp.ng_max, NP))
+    qp.D[0] = junk((qp.ng_max, NPOS))
     qp.lg[0] = junk(qp.ng_max)
     for n in range(qp.horizon + 1):
         for i in range(qp.ng_max):
             if n == 0 or i >= qp.ng[n]:
-                qp.D[n, i] = junk(NP)
+                qp.D[n, i] = junk(NPOS)
                 qp.lg[n, i] = junk(1)[0]
                 qp.soft[n, i] = int(rng.integers(-3, 3))
                 qp.zl[n, i] = junk(1)[0]

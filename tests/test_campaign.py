@@ -34,9 +34,9 @@ from humanmpc.eval.runner import run_campaign
 from humanmpc.eval.store import CampaignFolderError, ResultStore
 from humanmpc.eval.traces import trace_to_log
 from humanmpc.eval.worker import MEASURED_COLUMNS, make_task_planner, run_task
-from humanmpc.planners import solver_dir
+from humanmpc.planners import solver_cache
 from humanmpc.planners.registry import planner_factory
-from humanmpc.planners.solver_dir import cached_solver
+from humanmpc.planners.solver_cache import cached_solver
 from humanmpc.sim.scenarios import make_scenario
 
 from .conftest import needs_data
@@ -54,7 +54,7 @@ QUIET = lambda _m: None  # noqa: E731
 
 @pytest.fixture(autouse=True)
 def _restore_solver_choice(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(solver_dir, "_choice", solver_dir.SolverChoice())
+    monkeypatch.setattr(solver_cache, "_choice", solver_cache.SolverChoice())
 
 
 def campaign(default_dir: Path, traces: str = "all", **changes: Any) -> Campaign:
@@ -98,7 +98,7 @@ def reference(default_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Re
     try:
         record = run_campaign(tasks_of(c), store, InProcess(), progress=False, say=QUIET)
     finally:
-        solver_dir.select_solver()  # the tasks chose this process's solver; back to the default
+        solver_cache.select_solver()  # the tasks chose this process's solver; back to the default
     assert record.ran == 16 and not record.interrupted
     return Reference({r["key"]: r for r in store.read_rows()}, store)
 

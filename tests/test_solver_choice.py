@@ -1,5 +1,5 @@
 """simulate, evaluate and demo evaluate a user's own spec (--spec) or package (--solver-dir), and never
-overwrite a generated folder the tools did not create (humanmpc.planners.solver_dir).
+overwrite a generated folder the tools did not create (humanmpc.planners.solver_cache).
 
 Real generated C built by the real compiler throughout; the specs are small (N = 20, N_h <= 3) to keep
 the builds short. Every test runs in its own working folder, where the tools keep their cache
@@ -19,8 +19,8 @@ import humanmpc
 from humanmpc import cli
 from humanmpc.codegen.build import is_stale
 from humanmpc.codegen.spec import Spec, load_spec
-from humanmpc.planners import solver_dir
-from humanmpc.planners.solver_dir import CACHE_MARKER, SolverDirError, cache_dir, ensure_solver
+from humanmpc.planners import solver_cache
+from humanmpc.planners.solver_cache import CACHE_MARKER, SolverDirError, cache_dir, ensure_solver
 
 from .conftest import make_solver
 
@@ -34,7 +34,7 @@ EVALUATE = ["evaluate", "--scenarios", "crossing_group", "--planners", "mpc", "-
 @pytest.fixture(autouse=True)
 def _fresh_choice(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     """Each test in its own working folder, and the process's solver choice restored after it."""
-    monkeypatch.setattr(solver_dir, "_choice", solver_dir.SolverChoice())
+    monkeypatch.setattr(solver_cache, "_choice", solver_cache.SolverChoice())
     monkeypatch.chdir(tmp_path)
 
 
@@ -183,10 +183,10 @@ def test_make_planner_loads_the_selected_solver_and_by_default_the_default_spec_
     from humanmpc.planners.mpc import ensure_solver as reexported
     from humanmpc.planners.registry import make_planner, select_solver
 
-    choice = solver_dir.selected_solver()
+    choice = solver_cache.selected_solver()
     assert choice.spec is None and choice.solver_dir is None
-    expected = Path("generated", ".cache", f"paper-{solver_dir.cache_key(Spec())}")
-    assert expected == DEFAULT_SOLVER_DIR == solver_dir.DEFAULT_SOLVER_DIR and reexported is ensure_solver
+    expected = Path("generated", ".cache", f"paper-{solver_cache.cache_key(Spec())}")
+    assert expected == DEFAULT_SOLVER_DIR == solver_cache.DEFAULT_SOLVER_DIR and reexported is ensure_solver
     select_solver(solver_dir=user_dir)
     held = humanmpc.load(user_dir).spec_hash
     for name in ("mpc", "mpc_paper"):

@@ -30,6 +30,7 @@ from ..bindings import load
 from ..codegen.build import build, compiler_and_flags
 from ..codegen.generate import generate
 from ..codegen.spec import Spec, resolve_spec
+from ..sim.unicycle import euler
 from ..solver import Solver
 from ..status import QP_STATUS_NAMES, STOP_REASONS
 
@@ -70,13 +71,6 @@ class BenchResult:
     solved_fraction: float  # of the steps where a QP ran
     stops: dict[str, int]
     min_human_distance: float
-
-
-def unicycle_step(x: np.ndarray, u: np.ndarray, dt: float, substeps: int = 10) -> np.ndarray:
-    h = dt / substeps
-    for _ in range(substeps):
-        x = x + h * np.array([x[3] * np.cos(x[2]), x[3] * np.sin(x[2]), u[1], u[0]])
-    return x
 
 
 class CrowdScene:
@@ -147,7 +141,7 @@ def run_closed_loop(solver: Solver, k: int, seed: int, steps: int,
         out["dist"].append(float(np.min(np.linalg.norm(scene.pos - x[:2], axis=1))) if k else np.inf)
         out["reason"].append(r.stop_reason)
         u = r.u0 if np.all(np.isfinite(r.u0)) else np.array([-1.0, 0.0])
-        x = unicycle_step(x, u, dims.dt)
+        x = euler(x, u, dims.dt)
         x[3] = min(max(x[3], 0.0), 1.0)
         scene.advance(dims.dt)
     return out

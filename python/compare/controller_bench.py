@@ -27,6 +27,7 @@ from ..codegen.build import build, compiler_and_flags
 from ..codegen.generate import generate
 from ..codegen.spec import Spec, resolve_spec
 from ..controller import Controller
+from ..sim.unicycle import euler
 from ..status import OUTCOME_NAMES
 from .bench import (
     OBSTACLE_CENTRE,
@@ -35,7 +36,6 @@ from .bench import (
     TimingStats,
     machine_description,
     pin_to_one_core,
-    unicycle_step,
 )
 
 OBSTACLE_POINTS = 64  # points on the obstacle's boundary, 3 cm apart
@@ -86,7 +86,7 @@ def run_controller_loop(ctl: Controller, tracks: int, seed: int, steps: int) -> 
         out["outcome"].append(r.outcome)
         out["dist"].append(float(np.min(np.linalg.norm(scene.pos - x[:2], axis=1))) if tracks else np.inf)
         omega = float(r.command[1])
-        x = unicycle_step(x, r.u, dt)
+        x = euler(x, r.u, dt)
         x[3] = min(max(x[3], 0.0), 1.0)
         scene.advance(dt)
     return out

@@ -53,6 +53,7 @@ from numpy.typing import NDArray
 
 from ..bindings import load
 from ..codegen.cli import non_negative_int, output_dir
+from ..codegen.manifest import held_spec_hash
 from ..codegen.reference_nlp import ReferenceNlp
 from ..codegen.spec import Spec, load_spec, resolve_spec
 from .bench import cpu_name
@@ -312,7 +313,7 @@ def _run_ours(spec: Spec, solver_dir: str | Path | None, out: Path, replay: Repl
     replay's problem parameters and then ``params`` on top."""
     if solver_dir is None:
         solver_dir = out / "solvers" / f"{spec.name}_{spec.humans.max}"
-        if not (solver_dir / "manifest.json").is_file() or params is None:
+        if held_spec_hash(solver_dir) != spec.digest() or params is None:
             from ..codegen.generate import generate
 
             solver_dir = generate(spec, solver_dir, force=True, log=lambda _m: None)

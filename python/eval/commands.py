@@ -17,7 +17,7 @@ The three commands take ``--spec FILE`` and ``--solver-dir DIR`` for the solver 
 their cache, ``generated/.cache/<name>-<hash>/`` (reused while the spec is unchanged); ``--solver-dir``
 uses a generated and built package as it is, never regenerating or rebuilding it (with ``--spec`` as
 well, it must hold that spec's solver); neither, the built-in default spec's solver in the cache
-(:mod:`humanmpc.planners.solver_dir`). The episodes' prediction horizon is the solver's N; its
+(:mod:`humanmpc.planners.solver_cache`). The episodes' prediction horizon is the solver's N; its
 interval T / N must be the simulation's control period, 0.1 s.
 """
 
@@ -33,7 +33,7 @@ from pathlib import Path
 from ..codegen.cli import non_negative_int, output_dir, positive_int
 from ..codegen.spec import Spec, load_spec
 from ..planners.registry import planner_names
-from ..planners.solver_dir import CACHE_DIR, SolverDirError, check_solver_dir, select_solver
+from ..planners.solver_cache import CACHE_DIR, SolverDirError, check_solver_dir, select_solver
 from ..sim.scenarios import CROWD_MODELS, RECORDED_CROSSINGS, RECORDED_SCENARIOS, SCENARIOS, SIMULATED_SCENARIOS
 from .episode import EpisodeConfig
 from .extras import require
@@ -48,9 +48,8 @@ def choose_solver(spec_file: Path | None, solver_dir: Path | None) -> EpisodeCon
     spec = load_spec(spec_file) if spec_file is not None else None
     source = str(spec_file) if spec_file is not None else None
     if solver_dir is not None:
-        dims = check_solver_dir(solver_dir, spec, source)["dims"]
-        assert isinstance(dims, dict)
-        N, dt, where = int(dims["N"]), float(dims["dt"]), f"the solver in {solver_dir}"
+        dims = check_solver_dir(solver_dir, spec, source).dims
+        N, dt, where = dims.N, dims.dt, f"the solver in {solver_dir}"
     else:
         resolved = spec or Spec()
         N, dt, where = resolved.horizon.N, resolved.dt, str(spec_file or "the built-in spec")

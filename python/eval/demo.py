@@ -1,7 +1,7 @@
 """The main job (make demo): the paper's "crossing group" scenario with the MPC and the DWB baseline
 (any other registered scenario by name, e.g. a recorded crowd).
 
-Takes the MPC planners' solver chosen for this process (``humanmpc.planners.solver_dir``: by default the
+Takes the MPC planners' solver chosen for this process (``humanmpc.planners.solver_cache``: by default the
 built-in default spec's, generated and built into the tools' cache when it is not there yet), runs the
 planners on the same seeded scenario (the MPC in the evaluation's configuration and in the paper's,
 docs/evaluation.md, and the DWB), prints their metrics side by side and a timing summary, and writes
@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..planners.registry import make_planner
-from ..planners.solver_dir import ensure_solver
+from ..planners.solver_cache import ensure_solver
 from ..sim.scenarios import make_scenario
 from .episode import EpisodeConfig, EpisodeLog, run_episode
 from .metrics import compute_metrics, with_unit

@@ -29,7 +29,7 @@ import numpy as np
 
 from ..codegen.spec import Spec
 from ..planners.registry import planner_factory, planner_names
-from ..planners.solver_dir import held_spec_hash, selected_solver
+from ..planners.solver_cache import held_spec_hash, selected_solver
 from ..sim.scenarios import SCENARIOS, check_seeds
 from .campaign import Campaign, EpisodeTask, ParamValue, PlannerConfig, SolverRef, grid_points
 from .engines import make_engine
@@ -179,7 +179,7 @@ class EvaluationResult:
 
 
 def solver_ref() -> SolverRef:
-    """The solver this process's MPC planners load (:func:`humanmpc.planners.solver_dir.select_solver`), as
+    """The solver this process's MPC planners load (:func:`humanmpc.planners.solver_cache.select_solver`), as
     workers elsewhere can find it again."""
     choice = selected_solver()
     if choice.solver_dir is not None:

@@ -3,7 +3,7 @@ and (if asked) its per-step trace. Runs in any process that has humanmpc: a Dask
 or another one, or the submitting process itself.
 
 The solver: before a task's planner is made, the process's solver choice
-(:func:`humanmpc.planners.solver_dir.select_solver`) is set to the task's :class:`SolverRef`: a spec's solver
+(:func:`humanmpc.planners.solver_cache.select_solver`) is set to the task's :class:`SolverRef`: a spec's solver
 is generated and built into this worker's cache (``generated/.cache/`` in its working folder) by the first
 planner that needs it and reused by every later task; the cache builds in a staging folder renamed into
 place under a file lock, so workers sharing a folder build one spec once and never see a half-built
@@ -25,7 +25,7 @@ from ..codegen.resources import generator_digest
 from ..codegen.spec import Spec
 from ..planners.interface import Planner
 from ..planners.registry import make_planner
-from ..planners.solver_dir import SolverChoice, held_spec_hash, select_solver, selected_solver
+from ..planners.solver_cache import SolverChoice, held_spec_hash, select_solver, selected_solver
 from ..sim.scenarios import make_scenario
 from .campaign import EpisodeTask, SolverRef
 from .episode import run_episode

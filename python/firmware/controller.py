@@ -365,7 +365,7 @@ def write_controller_firmware(solver_dir: str | Path, replay: ControllerReplay, 
     d = Path(solver_dir).resolve()
     m = read_manifest(d)
     check_controller_replay_fits(replay, d)
-    name, real = str(m["name"]), str(m["real"])
+    name, real = m.name, m.real
     context = {"name": name, "NAME": name.upper(), "version": __version__, "real": real, "cold": cold,
                **controller_context(replay, real)}
     out = d / "firmware"

@@ -250,16 +250,13 @@ def replay_context(replay: Replay, real: str) -> dict[str, Any]:
 
 
 def check_replay_fits(replay: Replay, solver_dir: Path) -> None:
-    m = read_manifest(solver_dir)
-    dims = m["dims"]
-    assert isinstance(dims, dict)
+    dims = read_manifest(solver_dir).dims
     problems = []
-    if dims["N"] != replay.N or abs(replay.dt - float(dims["dt"])) > 1e-12:
-        problems.append(f"the replay has N={replay.N}, dt={replay.dt:g}; the solver N={dims['N']}, "
-                        f"dt={dims['dt']:g}")
-    if int(np.max(replay.n_humans, initial=0)) > int(dims["nh"]):
+    if dims.N != replay.N or abs(replay.dt - dims.dt) > 1e-12:
+        problems.append(f"the replay has N={replay.N}, dt={replay.dt:g}; the solver N={dims.N}, dt={dims.dt:g}")
+    if int(np.max(replay.n_humans, initial=0)) > dims.nh:
         problems.append(f"the replay has up to {int(np.max(replay.n_humans))} humans; the solver handles "
-                        f"N_h = {dims['nh']}")
+                        f"N_h = {dims.nh}")
     if problems:
         raise FirmwareError(f"the replay does not fit the solver in {solver_dir}: " + "; ".join(problems))
 
@@ -271,9 +268,7 @@ def write_firmware(solver_dir: str | Path, replay: Replay, *, cold: bool = False
     d = Path(solver_dir).resolve()
     m = read_manifest(d)
     check_replay_fits(replay, d)
-    name, real = str(m["name"]), str(m["real"])
-    dims = m["dims"]
-    assert isinstance(dims, dict)
+    name, real = m.name, m.real
     context = {"name": name, "NAME": name.upper(), "version": __version__, "real": real, "cold": cold,
                **replay_context(replay, real)}
     out = d / "firmware"

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from ..sim.robot import integrate
+from ..sim.unicycle import integrate
 from .global_path import GlobalPlanner, GridConfig, local_segment
 from .interface import Observation, PlanResult, protective_stop
 

@@ -34,8 +34,8 @@ from ..sim.sensors import ObstacleSensor
 from ..solver import Solver
 from .global_path import GlobalPlanner, GridConfig
 from .interface import Observation, PlanResult
-from .solver_dir import DEFAULT_SOLVER_DIR as DEFAULT_SOLVER_DIR  # moved to solver_dir, re-exported here
-from .solver_dir import ensure_solver as ensure_solver
+from .solver_cache import DEFAULT_SOLVER_DIR as DEFAULT_SOLVER_DIR  # moved to solver_cache, re-exported here
+from .solver_cache import ensure_solver as ensure_solver
 
 
 def paper_params() -> dict[str, Any]:

@@ -8,7 +8,7 @@ An evaluation ships each task's factory with it (:func:`planner_factory`; Dask p
 a script by value), so planners registered at run time run on workers that never registered them.
 
 The two MPC planners load the solver chosen for this process by
-:func:`~humanmpc.planners.solver_dir.select_solver` (re-exported here; the ``simulate``, ``evaluate``
+:func:`~humanmpc.planners.solver_cache.select_solver` (re-exported here; the ``simulate``, ``evaluate``
 and ``demo`` commands call it with their ``--spec`` / ``--solver-dir`` before any planner is made, and
 an evaluation's workers make the same choice from the task's solver reference); without a choice, the
 built-in default spec's solver in the tools' cache. A factory registered for another MPC configuration
@@ -23,8 +23,8 @@ from ..bindings import load
 from ..solver import Solver
 from .dwb import DWBPlanner
 from .interface import Planner
-from .solver_dir import ensure_solver
-from .solver_dir import select_solver as select_solver
+from .solver_cache import ensure_solver
+from .solver_cache import select_solver as select_solver
 
 PlannerFactory = Callable[[], Planner]
 

@@ -1,10 +1,8 @@
-"""The unicycle robot of the MPC and its exact-enough simulation.
+"""The simulated robot: the unicycle (humanmpc.sim.unicycle) with the limits a real base enforces.
 
-State ``x = [px, py, theta, v]``, control ``u = [a, omega]`` held constant over a control
-period; ``px' = v cos theta, py' = v sin theta, theta' = omega, v' = a``. The simulator
-integrates with RK4 substeps and enforces the limits the real base would: the control is
-clipped to the box, and v is kept in ``[v_min, v_max]`` by integrating up to the moment the
-bound is hit (the wheel controller saturates, it does not overshoot).
+The simulator integrates with RK4 substeps and enforces the limits the real base would: the control
+is clipped to the box, and v is kept in ``[v_min, v_max]`` by integrating up to the moment the bound
+is hit (the wheel controller saturates, it does not overshoot).
 """
 
 from __future__ import annotations
@@ -13,6 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from .unicycle import integrate as integrate
+from .unicycle import velocity_vector as velocity_vector
+from .unicycle import wrap_angle as wrap_angle
 
 FloatArray = NDArray[np.float64]
 
@@ -56,31 +58,6 @@ class RobotModel:
             raise ValueError("RobotModel: radii must be > 0 and substeps >= 1")
 
 
-def unicycle_rhs(x: FloatArray, u: FloatArray) -> FloatArray:
-    """Time derivative of the state, vectorised over leading axes (u broadcasts against x)."""
-    theta, v = x[..., 2], x[..., 3]
-    a = np.broadcast_to(u[..., 0], v.shape)
-    omega = np.broadcast_to(u[..., 1], v.shape)
-    return np.stack([v * np.cos(theta), v * np.sin(theta), omega, a], axis=-1)
-
-
-def rk4(x: FloatArray, u: FloatArray, h: float) -> FloatArray:
-    """One classical Runge-Kutta step of length h with u held constant."""
-    k1 = unicycle_rhs(x, u)
-    k2 = unicycle_rhs(x + 0.5 * h * k1, u)
-    k3 = unicycle_rhs(x + 0.5 * h * k2, u)
-    k4 = unicycle_rhs(x + h * k3, u)
-    return x + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-
-
-def integrate(x: FloatArray, u: FloatArray, dt: float, substeps: int = 4) -> FloatArray:
-    """Unconstrained RK4 over dt (vectorised), ``substeps`` equal substeps."""
-    h = dt / substeps
-    for _ in range(substeps):
-        x = rk4(x, u, h)
-    return x
-
-
 def step(model: RobotModel, x: ArrayLike, u: ArrayLike, dt: float) -> FloatArray:
     """Apply ``u`` (clipped to the limits) for ``dt`` from state ``x`` and return the next state.
 
@@ -110,14 +87,3 @@ def step(model: RobotModel, x: ArrayLike, u: ArrayLike, dt: float) -> FloatArray
         x = integrate(x, u, dt, model.substeps)
     x[2] = wrap_angle(x[2])
     return x
-
-
-def wrap_angle(angle: ArrayLike) -> FloatArray:
-    """Angle(s) wrapped into (-pi, pi]."""
-    return np.pi - np.mod(np.pi - np.asarray(angle, dtype=float), 2 * np.pi)
-
-
-def velocity_vector(x: ArrayLike) -> FloatArray:
-    """World-frame velocity (vx, vy) of a state."""
-    x = np.asarray(x, dtype=float)
-    return np.stack([x[..., 3] * np.cos(x[..., 2]), x[..., 3] * np.sin(x[..., 2])], axis=-1)

@@ -172,7 +172,7 @@ static void check_certificate(int case_id)
             if (n < HM_N) {
                 for (k = 0; k < HM_NX; k++) g += (double)(g_qp.A[n][k + i * HM_NX] * g_sol.pi[n][k]);
             }
-            for (k = 0; k < g_qp.ng[n] && i < HM_NP; k++) g -= (double)(g_qp.D[n][k][i] * g_sol.lam_lg[n][k]);
+            for (k = 0; k < g_qp.ng[n] && i < HM_NPOS; k++) g -= (double)(g_qp.D[n][k][i] * g_sol.lam_lg[n][k]);
             worst = fmax(worst, fabs(g));
             if (ocp_qp_bound_present(g_qp.lbx[n][i])) value += (double)(g_qp.lbx[n][i] * g_sol.lam_lbx[n][i]);
             if (ocp_qp_bound_present(g_qp.ubx[n][i])) value -= (double)(g_qp.ubx[n][i] * g_sol.lam_ubx[n][i]);

@@ -143,13 +143,13 @@ class IpoptReference:
         if replay.spec_hash != self.spec.digest():
             raise ReplayError(f"the replay was recorded for spec {replay.spec_hash[:12]}, this Ipopt reference "
                               f"was built for {self.spec.digest()[:12]}")
-        P = np.empty((replay.steps, self.nlp.np))
+        P = np.empty((replay.steps, self.nlp.n_param))
         for t in range(replay.steps):
             P[t] = self.nlp.params.pack(**replay.inputs(t), params=replay.params)
         with path.open("wb") as f:
             f.write(b"HMIPIN01")
             f.write(self.spec.digest().encode("ascii"))
-            f.write(np.array([self.nlp.np, self.nlp.nw, replay.steps], dtype="<i4").tobytes())
+            f.write(np.array([self.nlp.n_param, self.nlp.nw, replay.steps], dtype="<i4").tobytes())
             f.write(np.ascontiguousarray(P, dtype="<f8").tobytes())
         return path
 
@@ -201,7 +201,7 @@ def render_program(nlp: ReferenceNlp, gen: GeneratedNlp, name: str) -> dict[str,
 
     context = {
         "name": c_identifier(name), "prefix": c_identifier(gen.prefix), "version": __version__,
-        "spec_hash": nlp.spec.digest(), "nw": gen.nw, "ng": gen.ng, "np": gen.np, "N": nlp.N,
+        "spec_hash": nlp.spec.digest(), "nw": gen.nw, "ng": gen.ng, "n_param": gen.n_param, "N": nlp.N,
         "u_offset": nlp.decision.u_offset, "s_offset": nlp.decision.s_offset,
         "nnz_jac": len(gen.jac_rows), "nnz_hess": len(gen.hess_rows),
         "jac_rows": ints(gen.jac_rows), "jac_cols": ints(gen.jac_cols),

@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import fcntl
 import hashlib
-import json
 import os
 import shutil
 import sys
@@ -39,7 +38,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..codegen.build import build, is_stale
-from ..codegen.generate import MANIFEST, generate
+from ..codegen.generate import generate
+from ..codegen.manifest import MANIFEST, Manifest, ManifestError
+from ..codegen.manifest import held_spec_hash as held_spec_hash
 from ..codegen.resources import generator_digest
 from ..codegen.spec import Spec
 
@@ -77,17 +78,7 @@ def _spec_label(spec: Spec, source: str | None) -> str:
         f"the spec of solver '{spec.name}' (sha256 {spec.digest()})"
 
 
-def held_spec_hash(solver_dir: Path) -> str | None:
-    """The spec hash in ``solver_dir``'s manifest, None when there is no readable manifest."""
-    try:
-        data = json.loads((Path(solver_dir) / MANIFEST).read_text())
-        value = data["spec_hash"]
-    except (OSError, ValueError, KeyError, TypeError):
-        return None
-    return value if isinstance(value, str) else None
-
-
-def check_solver_dir(solver_dir: Path, spec: Spec | None = None, source: str | None = None) -> dict[str, object]:
+def check_solver_dir(solver_dir: Path, spec: Spec | None = None, source: str | None = None) -> Manifest:
     """The manifest of the built package in ``solver_dir`` (of ``spec``, if given); reads, never writes.
 
     ``SolverDirError`` when the folder is missing, holds no humanmpc package, holds another spec's
@@ -102,18 +93,14 @@ def check_solver_dir(solver_dir: Path, spec: Spec | None = None, source: str | N
     if not (d / MANIFEST).is_file():
         raise SolverDirError(f"{d} holds no generated humanmpc solver (no {MANIFEST}): {generate_it}")
     try:
-        manifest = json.loads((d / MANIFEST).read_text())
-    except (OSError, ValueError) as err:
-        raise SolverDirError(f"{d / MANIFEST} is not a humanmpc manifest ({err}): regenerate the package "
-                             f"(humanmpc-gen generate SPEC -o {d} --force)") from None
-    held = manifest.get("spec_hash") if isinstance(manifest, dict) else None
-    if not isinstance(held, str) or not isinstance(manifest.get("name"), str):
-        raise SolverDirError(f"{d / MANIFEST} has no solver name or spec hash: regenerate the package "
-                             f"(humanmpc-gen generate SPEC -o {d} --force)")
+        manifest = Manifest.read(d)
+    except ManifestError as err:
+        raise SolverDirError(str(err)) from None
+    held = manifest.spec_hash
     if spec is not None and held != spec.digest():
         what = source or "SPEC"
         raise SolverDirError(
-            f"{d} holds the solver '{manifest['name']}' of spec sha256 {held}, not that of "
+            f"{d} holds the solver '{manifest.name}' of spec sha256 {held}, not that of "
             f"{_spec_label(spec, source)}. humanmpc's tools do not regenerate a folder they did not create: "
             f"regenerate it yourself (humanmpc-gen generate {what} -o {d} --force && humanmpc-gen build {d}), "
             f"give --solver-dir {d} alone to use its solver as it is, or give --spec {what} alone to let the "
