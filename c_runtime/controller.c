@@ -101,6 +101,7 @@ HM_FUNC void controller_reset(hm_controller *c)
     c->has_recovery = 0;
     c->has_theta = 0;
     c->has_origin = 0;
+    c->arriving = 0;
     controller_candidates_reset(c);
     c->best_left = HM_INF;
     c->time_progress = HM_R(0.0);
@@ -410,6 +411,22 @@ static void controller_brake(hm_controller *c)
     ocp_nlp_sqp_reset(&c->solver);
 }
 
+/* 1 once the robot has come within goal_tolerance of this goal (nav2's stateful goal checker): a robot that
+ * enters the tolerance at speed brakes to a standstill where the braking carries it (past the tolerance,
+ * by at most its braking distance), and turns to the goal's heading there; the plan would otherwise turn
+ * back at speed and overshoot again. A new goal ends it. */
+static int controller_arriving(hm_controller *c, const hm_controller_goal *g)
+{
+    if (!(c->arriving && c->arrival_goal[0] == g->final[0] && c->arrival_goal[1] == g->final[1]))
+        c->arriving = 0;
+    if (g->to_final <= c->params.goal_tolerance) {
+        c->arriving = 1;
+        c->arrival_goal[0] = g->final[0];
+        c->arrival_goal[1] = g->final[1];
+    }
+    return c->arriving;
+}
+
 /* What the robot does within goal_tolerance of its goal (controller_at_goal). */
 enum controller_at_goal_state {
     CONTROLLER_GOAL_DONE,    /* the heading is within yaw_goal_tolerance, or there is none to meet: braking */
@@ -576,7 +593,7 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
     in->goal[1] = g.carrot[1];
     in->goal[2] = g.carrot[2];
     controller_solver_params(c, &g);
-    if (g.to_final <= c->params.goal_tolerance) {
+    if (controller_arriving(c, &g)) {
         /* reached: within the tolerance, the heading met, and at rest (nav2's stopped goal checker); until the
          * robot stands, it is braking towards its goal */
         const enum controller_at_goal_state state = controller_at_goal(c, cin, g.final[2]);

@@ -35,4 +35,7 @@ typedef struct HM_NS(controller) {
 #endif
     int chosen_id;
     int chosen_side;
+    /* Arriving at the goal arrival_goal: braking to a standstill since it came within goal_tolerance. */
+    int arriving;
+    HM_REAL arrival_goal[2];
 } HM_NS(controller);
