@@ -419,7 +419,7 @@ def test_default_float_controller_replays_on_a_cortex_m4f_within_192_kib_of_ram(
     obstacle points) with one plan, the whole controller around its solver, linked into 192 KiB of RAM
     with the stack at its top: it runs the recorded closed loop, with room for its stack, and computes the
     float host's commands bit for bit. Linked into 96 KiB it does not fit (the limit is real). Each
-    candidate plan adds a solver and its output (about 120 KB in float): the default's three, or two, do
+    candidate plan adds a solver and its output (about 135 KB in float): the default's three, or two, do
     not fit 192 KiB (docs/firmware.md)."""
     d = make_solver(fw_root, {"name": "fw192", "precision": "float", "controller": {"candidates": 1}})
     run, agree, elf, _ = fc.run_controller_firmware(d, "cortex-m4", steps=60, seed=0, ram_bytes=RAM_192K,
