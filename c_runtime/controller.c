@@ -193,9 +193,9 @@ static const hm_real *controller_origin(hm_controller *c, const hm_controller_in
 }
 
 /* The progress objective's goal per node (params.progress): node n's goal is the point of the path where
- * a robot that started at its projection now would be at node n's time, going at the speed it could go:
- * from its measured speed (at least 0), accelerating at the upper bound towards the speed to track
- * (in->goal[3]: the cruising speed, lowered by speed and separation), and braking at half the lower bound
+ * a robot that started at its projection now would be at node n's time, going at the speed to track
+ * (in->goal[3]: the cruising speed, lowered by speed and separation; not the measured speed, from which a
+ * standing robot's goals would move off too slowly to ever start it) and braking at half the lower bound
  * to arrive at the goal at rest; heading: the path's there; speed: that speed. Motion that does not bring
  * the robot along its path falls behind these goals and costs; so does standing, once they have moved on.
  * Sets in->refs and in->has_refs. */
@@ -203,17 +203,18 @@ static void controller_references(hm_controller *c, const hm_controller_input *c
 {
     hm_input *in = &c->in;
     const hm_params *sp = &c->solver.params;
-    const hm_real dt = HM_R(HM_DT), a_up = sp->a_bounds[1], a_down = HM_R(-0.5) * sp->a_bounds[0];
+    const hm_real dt = HM_R(HM_DT), a_down = HM_R(-0.5) * sp->a_bounds[0];
+    const hm_real *origin = controller_origin(c, cin);
     hm_real v = in->goal[3], d = HM_R(0.0);
     int n;
     for (n = 0; n <= HM_N; n++) {
         const hm_real left = hm_fmax(g->length - g->s_proj - d, HM_R(0.0));
         hm_real *r = in->refs[n];
-        controller_path_at(cin, controller_origin(c, cin), in->x0[2], g->s_proj + d, g, r);
+        controller_path_at(cin, origin, in->x0[2], g->s_proj + d, g, r);
         r[3] = v;
         d += v * dt;
-        v = hm_fmin(hm_fmin(in->goal[3], v + a_up * dt),
-                    hm_sqrt(HM_R(2.0) * a_down * hm_fmax(left - v * dt, HM_R(0.0))));
+        /* from the speed to track, the speed only falls (the braking term shrinks with the way left) */
+        v = hm_fmin(in->goal[3], hm_sqrt(HM_R(2.0) * a_down * hm_fmax(left - v * dt, HM_R(0.0))));
     }
     in->has_refs = 1;
 }
