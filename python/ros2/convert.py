@@ -91,21 +91,20 @@ def people_arrays(msg: PointCloud2) -> tuple[np.ndarray, np.ndarray | None, np.n
         formats.append(order + _NUMPY_OF[f.datatype])
         offsets.append(int(f.offset))
     dtype = np.dtype({"names": names, "formats": formats, "offsets": offsets, "itemsize": int(msg.point_step)})
-    if k * int(msg.point_step) > len(msg.data) or max(o + dtype[n].itemsize for n, o in zip(names, offsets,
-                                                                                            strict=True)) > dtype.itemsize:
+    widest = max(o + dtype[n].itemsize for n, o in zip(names, offsets, strict=True))
+    if k * int(msg.point_step) > len(msg.data) or widest > dtype.itemsize:
         raise MessageError(f"the people cloud's data holds {len(msg.data)} bytes, too few for {k} points of "
                            f"{msg.point_step} bytes with its fields")
     rec = np.frombuffer(bytes(msg.data), dtype=dtype, count=k) if k else np.zeros(0, dtype=dtype)
     tracks = np.column_stack([rec[n].astype(np.float64) for n in PEOPLE_REQUIRED]) if k else np.zeros((0, 4))
     ids = None
-    if "id" in rec.dtype.names:
+    if "id" in names:
         raw = rec["id"]
-        if np.issubdtype(raw.dtype, np.floating):
-            if not np.all(np.isfinite(raw) & (raw == np.round(raw))):
-                raise MessageError("the people cloud's field id must hold whole numbers")
+        if np.issubdtype(raw.dtype, np.floating) and not np.all(np.isfinite(raw) & (raw == np.round(raw))):
+            raise MessageError("the people cloud's field id must hold whole numbers")
         ids = (raw.astype(np.int64) & 0x7FFFFFFF).astype(np.int64)
     cov = None
-    if all(n in rec.dtype.names for n in ("cov_xx", "cov_xy", "cov_yy")):
+    if all(n in names for n in ("cov_xx", "cov_xy", "cov_yy")):
         cov = np.column_stack([rec[n].astype(np.float64) for n in ("cov_xx", "cov_xy", "cov_yy")]).reshape(k, 3)
         cov[~(cov[:, 0] > 0.0)] = np.nan  # none given: NaN, or a zero or negative xx
     return tracks, ids, cov
@@ -127,7 +126,7 @@ def people_cloud(header: Any, tracks: np.ndarray, ids: np.ndarray | None = None,
     msg = PointCloud2()
     msg.header = header
     msg.height, msg.width = 1, k
-    msg.fields = [PointField(name=n, offset=int(dtype.fields[n][1]),
+    msg.fields = [PointField(name=n, offset=int(dtype.fields[n][1]),  # type: ignore[index]
                              datatype=PointField.UINT32 if n == "id" else PointField.FLOAT64, count=1) for n in names]
     msg.is_bigendian = False
     msg.point_step = dtype.itemsize
@@ -219,6 +218,9 @@ def status(header: Any, name: str, level: int, message: str, values: dict[str, A
     return msg
 
 
-OK = int.from_bytes(DiagnosticStatus.OK, "little") if isinstance(DiagnosticStatus.OK, bytes) else int(DiagnosticStatus.OK)
-WARN = (int.from_bytes(DiagnosticStatus.WARN, "little") if isinstance(DiagnosticStatus.WARN, bytes)
-        else int(DiagnosticStatus.WARN))
+def _level(value: Any) -> int:
+    return int.from_bytes(value, "little") if isinstance(value, bytes) else int(value)
+
+
+OK = _level(DiagnosticStatus.OK)
+WARN = _level(DiagnosticStatus.WARN)

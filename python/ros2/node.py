@@ -8,6 +8,7 @@ does is the C controller's decision; this module converts. Topics, parameters, Q
 
 from __future__ import annotations
 
+import contextlib
 import math
 import sys
 import time
@@ -16,15 +17,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
-from nav_msgs.msg import Odometry, Path as PathMsg
+from nav_msgs.msg import Odometry
+from nav_msgs.msg import Path as PathMsg
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor, ParameterType, SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data)
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan, PointCloud2
 from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
@@ -54,7 +55,7 @@ def _descriptor(p: Param) -> ParameterDescriptor:
         assert p.valid is not None
         lo, hi = p.valid.lo, p.valid.hi
         if math.isfinite(lo) and math.isfinite(hi):
-            d.integer_range = [IntegerRange(from_value=int(math.ceil(lo)), to_value=int(math.floor(hi)), step=1)]
+            d.integer_range = [IntegerRange(from_value=math.ceil(lo), to_value=math.floor(hi), step=1)]
     elif p.size > 1:
         d.type = ParameterType.PARAMETER_DOUBLE_ARRAY
     else:
@@ -98,7 +99,7 @@ def _ros_value(p: Param, value: Any) -> Any:
     return float(value)
 
 
-class ParameterRefused(ValueError):
+class ParameterRefusedError(ValueError):
     pass
 
 
@@ -128,8 +129,8 @@ class ControllerNode(Node):
         self.add_on_set_parameters_callback(self._on_set_parameters)
 
         self.inputs = {k: Latest() for k in ("odom", "people", "scan")}
-        self.goal: np.ndarray | None = None
-        self.path: np.ndarray | None = None
+        self.goal: PoseStamped | None = None
+        self.path: PathMsg | None = None
         self.node_stop: str | None = None
         self.announced: tuple[bool, int] | None = None
         self.command = (0.0, 0.0)
@@ -157,7 +158,7 @@ class ControllerNode(Node):
             value = self.get_parameter(q.name).value
             why = _check_node_param(q, value)
             if why is not None:
-                raise ParameterRefused(f"parameter {q.name}: {why}: {q.name} must be {q.rule}")
+                raise ParameterRefusedError(f"parameter {q.name}: {why}: {q.name} must be {q.rule}")
             out[q.name] = value
         return out
 
@@ -359,7 +360,7 @@ def main(solver_dir: str | Path, params_file: str | Path | None = None, node_nam
     ros_args = ["--ros-args", "--params-file", str(params_file)] if params_file is not None else []
     try:
         solver = load(solver_dir, build_if_needed=False)
-    except Exception as err:  # noqa: BLE001 - any load failure ends the node with its message
+    except Exception as err:
         print(f"{node_name}: cannot load the solver in {solver_dir}: {err}", file=sys.stderr)
         return 1
     if spec_hash is not None and getattr(solver, "spec_hash", spec_hash) != spec_hash:
@@ -369,16 +370,14 @@ def main(solver_dir: str | Path, params_file: str | Path | None = None, node_nam
     try:
         try:
             node = ControllerNode(node_name, solver.controller())
-        except (ParameterRefused, ValueError, KeyError) as err:
+        except (ParameterRefusedError, ValueError, KeyError) as err:
             print(f"{node_name}: {err}", file=sys.stderr)
             return 1
         except rclpy.exceptions.InvalidParameterValueException as err:
             print(f"{node_name}: {err}", file=sys.stderr)
             return 1
-        try:
+        with contextlib.suppress(KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
             rclpy.spin(node)
-        except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
-            pass
         node.destroy_node()
     finally:
         if rclpy.ok():
