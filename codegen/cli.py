@@ -42,6 +42,16 @@ def _cmd_ros(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_ros2(args: argparse.Namespace) -> int:
+    from .ros2 import write_ros2
+
+    out = write_ros2(args.dir, args.output, force=args.force)
+    print(out)
+    print(f"next: pip install 'humanmpc[ros2]' (or source ROS 2 Jazzy), then {out}/<name>_node.py  (docs/ros.md)",
+          file=sys.stderr)
+    return 0
+
+
 def _cmd_build(args: argparse.Namespace) -> int:
     lib = build(args.dir, cc=args.cc, cflags=args.cflags, native=args.native)
     print(lib)
@@ -164,6 +174,15 @@ def add_generator_commands(sub: argparse._SubParsersAction) -> None:
                    help="output folder (default: <name>_ros_src beside DIR)")
     p.add_argument("--force", action="store_true", help="replace an existing folder written by humanmpc-gen ros")
     p.set_defaults(func=_cmd_ros)
+
+    p = sub.add_parser("ros2", help="write the ROS 2 node (rclpy) of a generated, built solver",
+                       description="Write the ROS 2 node over the controller of DIR (a generated and built solver): "
+                       "its launcher, parameter file, launch file and a copy of the solver (docs/ros.md). Written "
+                       "atomically.")
+    p.add_argument("dir", type=Path, help="generated and built solver folder")
+    p.add_argument("-o", "--output", type=Path, help="output folder (default: <name>_ros2 beside DIR)")
+    p.add_argument("--force", action="store_true", help="replace an existing folder written by humanmpc-gen ros2")
+    p.set_defaults(func=_cmd_ros2)
 
     p = sub.add_parser("build", help="compile a generated package into its libraries",
                        description="Compile DIR (a generated package) with its Makefile into "
