@@ -12,11 +12,16 @@ import math
 from typing import Any
 
 import numpy as np
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import PoseStamped, Quaternion
-from nav_msgs.msg import Odometry, Path
-from sensor_msgs.msg import LaserScan, PointCloud2, PointField
-from visualization_msgs.msg import Marker, MarkerArray
+
+try:  # the ros2 extra
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+    from geometry_msgs.msg import PoseStamped, Quaternion
+    from nav_msgs.msg import Odometry, Path
+    from sensor_msgs.msg import LaserScan, PointCloud2, PointField
+    from visualization_msgs.msg import Marker, MarkerArray
+except ImportError as err:
+    raise ImportError(f"the ROS 2 node needs rclpy and the ROS 2 message packages ({err}): "
+                      "pip install 'humanmpc[ros2]', or source ROS 2 Jazzy (docs/ros.md)") from None
 
 # The people cloud: required fields, then optional ones (absent, or NaN for a person: none given).
 PEOPLE_REQUIRED = ("x", "y", "vx", "vy")          # [m] position, [m/s] velocity, in header.frame_id

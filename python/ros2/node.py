@@ -17,18 +17,28 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import rclpy
-from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
-from nav_msgs.msg import Odometry
-from nav_msgs.msg import Path as PathMsg
-from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor, ParameterType, SetParametersResult
-from rclpy.node import Node
-from rclpy.parameter import Parameter
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
-from sensor_msgs.msg import LaserScan, PointCloud2
-from std_msgs.msg import Header
-from visualization_msgs.msg import MarkerArray
+try:  # the ros2 extra
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticArray
+    from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
+    from nav_msgs.msg import Odometry
+    from nav_msgs.msg import Path as PathMsg
+    from rcl_interfaces.msg import (
+        FloatingPointRange,
+        IntegerRange,
+        ParameterDescriptor,
+        ParameterType,
+        SetParametersResult,
+    )
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+    from sensor_msgs.msg import LaserScan, PointCloud2
+    from std_msgs.msg import Header
+    from visualization_msgs.msg import MarkerArray
+except ImportError as err:
+    raise ImportError(f"the ROS 2 node needs rclpy and the ROS 2 message packages ({err}): "
+                      "pip install 'humanmpc[ros2]', or source ROS 2 Jazzy (docs/ros.md)") from None
 
 from .. import load
 from ..codegen.params import PARAMS, Param
