@@ -140,7 +140,7 @@ HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, 
         cost[k] = HM_INF;
         side[k] = (k - 1) % 2 == 0 ? 1 : -1;
         id[k] = j < in->n_humans ? out->people_ids[j] : -1;
-        if (j >= in->n_humans) continue;
+        if (j >= in->n_humans || !c->params.passing) continue;
         s->params = c->solver.params;
         s->clock = c->solver.clock;
         s->clock_ctx = c->solver.clock_ctx;

@@ -275,6 +275,9 @@ PARAMS: tuple[Param, ...] = (
     Param("progress_weights", "controller.progress_weights", "vector", (20.0, 20.0, 0.0, 1.0),
           "stage weights on x - g_n with the progress objective (g_n: the node's goal along the path)", size=4,
           valid=_WEIGHT, controller=True),
+    Param("passing", "controller.passing", "flag", True,
+          "solve the candidate plans of controller.candidates in every period (false: the main plan alone, "
+          "whatever the package's size; the paper's configuration)", controller=True, paper=False),
     Param("candidate_hysteresis", "controller.candidate_hysteresis", "real", 0.1,
           "with several candidate plans: another plan replaces the one applied last period only when it costs "
           "less by this fraction of its cost (the robot does not switch sides back and forth)",

@@ -298,6 +298,7 @@ class Controller:
     lookahead: float = param("controller.lookahead")
     progress: bool = param("controller.progress")
     progress_weights: tuple[float, ...] = param("controller.progress_weights")
+    passing: bool = param("controller.passing")
     candidate_hysteresis: float = param("controller.candidate_hysteresis")
     goal_clearance: float = param("controller.goal_clearance")
     goal_taper: float = param("controller.goal_taper")

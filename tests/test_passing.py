@@ -106,3 +106,32 @@ def test_a_person_coming_the_other_way_in_a_2_m_corridor_is_passed(ctl: Controll
     walls = np.vstack([np.column_stack([xs, np.full_like(xs, 1.0)]), np.column_stack([xs, np.full_like(xs, -1.0)])])
     got = run(ctl, np.array([[9.0, 0.0, -0.8, 0.0]]), obstacles=walls)
     assert_direct(got, free)
+
+
+def test_without_passing_decisions_a_three_plan_package_commands_what_a_one_plan_package_does(
+        passing_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> None:
+    """controller.passing = false (the paper's configuration) leaves the main plan alone, whatever the
+    package's number of candidates: the commands are bit for bit those of a one-plan package."""
+    one = make_solver(tmp_path_factory.mktemp("one_plan"), {"name": "one_plan", "controller": {"candidates": 1}})
+    three, single = humanmpc.load(passing_dir).controller(), humanmpc.load(one).controller()
+    three.set_params(passing=False)
+    people = np.array([[3.0, 3.0, 0.0, -0.8], [5.0, -0.5, -0.3, 0.0]])
+    model, x, chose_other = RobotModel(), np.zeros(4), 0
+    for k in range(120):
+        now = people.copy()
+        now[:, :2] += k * DT * now[:, 2:]
+        a = three.step(k * DT, pose=x[:3], v=x[3], goal=GOAL, people=now)
+        b = single.step(k * DT, pose=x[:3], v=x[3], goal=GOAL, people=now)
+        assert np.array_equal(a.u, b.u) and a.outcome == b.outcome, (k, a.u, b.u, a.outcome, b.outcome)
+        assert a.candidate == 0
+        x = step(model, x, a.u, DT)
+    three.set_params(passing=True)
+    three.reset()
+    x = np.zeros(4)
+    for k in range(120):  # the same package with its passing decisions does choose another plan here
+        now = people.copy()
+        now[:, :2] += k * DT * now[:, 2:]
+        r = three.step(k * DT, pose=x[:3], v=x[3], goal=GOAL, people=now)
+        chose_other += r.candidate != 0
+        x = step(model, x, r.u, DT)
+    assert chose_other > 0
