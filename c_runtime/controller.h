@@ -3,7 +3,7 @@
  * control period with odometry, a path or a goal, tracked people and obstacle points; it returns a
  * velocity command and says what it is doing (an outcome, a stop and its reason, goal reached,
  * stalled), never silently. Around the solver it does what a robot needs and the OCP alone does not:
- * the goal the OCP sees (controller_goal.h), the people and the obstacle it sees
+ * the goal the OCP sees (controller_path.h), the people and the obstacle it sees
  * (controller_people.h), the approach to the goal, the speed limit, loop and stall detection with a
  * recovery by a bounded SQP inside the deadline, the braking at the goal. Its last word on every period
  * is the safety guard (controller_safety.h): someone within d_h, speed and separation, the command's

@@ -21,7 +21,7 @@ enum hm_outcome { HM_OUTCOME_TABLE(HM_STATUS_ENUM_ROW) };
 
 #define HM_PI HM_R(3.14159265358979323846)
 
-/* The goal the OCP sees this period, from the path or the goal pose (controller_goal.c). */
+/* The goal the OCP sees this period, from the path or the goal pose (controller_path.c). */
 typedef struct hm_controller_goal {
     int has;              /* 0: no path and no goal */
     hm_real carrot[3];    /* [x, y, theta]: the point lookahead metres along the path, its heading */

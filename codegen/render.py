@@ -50,11 +50,15 @@ RUNTIME_SOURCES = (
     "ocp_nlp_rti.c",
     "ocp_nlp_sqp.c",
     "controller_common.c",
-    "controller_goal.c",
+    "controller_path.c",
     "controller_people.c",
     "controller_tracks.c",
     "controller_safety.c",
+    "controller_objective.c",
     "controller_candidates.c",
+    "controller_recovery.c",
+    "controller_goal_checker.c",
+    "controller_progress_checker.c",
     "controller.c",
 )
 

@@ -1,10 +1,10 @@
 /*
- * controller_goal.h: the goal the OCP sees in one period (controller_goal.c): the robot's projection
+ * controller_path.h: the goal the OCP sees in one period (controller_path.c): the robot's projection
  * on the reference path (or on the straight line to a goal pose), the distance left along it, and a
  * carrot lookahead metres further on, with the path's heading there.
  */
-#ifndef CONTROLLER_GOAL_H
-#define CONTROLLER_GOAL_H
+#ifndef CONTROLLER_PATH_H
+#define CONTROLLER_PATH_H
 #include "controller_common.h"
 
 /* From the path (n_path >= 2), a one-point path or a goal pose (a straight path from origin), or nothing
@@ -18,4 +18,4 @@ HM_FUNC void controller_goal(const hm_controller_input *cin, const hm_real *orig
 HM_FUNC void controller_path_at(const hm_controller_input *cin, const hm_real *origin, hm_real heading, hm_real s,
                                 const hm_controller_goal *g, hm_real *point);
 
-#endif /* CONTROLLER_GOAL_H */
+#endif /* CONTROLLER_PATH_H */

@@ -1,5 +1,5 @@
 /*
- * controller_goal.c: the goal the OCP sees (controller_goal.h).
+ * controller_path.c: the goal the OCP sees (controller_path.h).
  *
  * The OCP tracks a goal with a quadratic cost; handing it a goal metres away along a path that bends
  * would pull the plan across the bend (through the wall of a U-shaped obstacle). The carrot is the
@@ -8,7 +8,7 @@
  * heading) once it is within lookahead. The projection is the nearest point of the whole path, so a
  * path replanned from anywhere is followed from where the robot is.
  */
-#include "controller_goal.h"
+#include "controller_path.h"
 
 static hm_real controller_norm(hm_real dx, hm_real dy)
 {

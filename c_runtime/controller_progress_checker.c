@@ -1,0 +1,41 @@
+/*
+ * controller_progress_checker.c: progress towards the goal (controller_progress_checker.h).
+ *
+ * A robot that makes no progress while nothing stops it (a local solution in front of a person who does
+ * not move) is reported as stalled, and the recoveries (controller_recovery.h) try another start, at most
+ * once per stall_time.
+ */
+#include "controller_progress_checker.h"
+
+/* Progress towards the goal: the distance left must shrink by stall_distance within stall_time; a
+ * path that grows (a replanned detour) restarts the measure, not the timer; a protective stop or a
+ * new goal restarts both. Returns 1 when stalled; *slow: 1 when the robot has gone slower than half
+ * the speed it tracks for stall_time. */
+HM_FUNC int controller_progress(hm_controller *c, const hm_controller_input *cin, const hm_controller_goal *g,
+                                int stopped, int *slow, hm_controller_output *out)
+{
+    const hm_params *p = &c->params;
+    const int new_goal = !c->has_goal || hm_fabs(g->final[0] - c->goal_xy[0]) > HM_R(1e-6) ||
+                         hm_fabs(g->final[1] - c->goal_xy[1]) > HM_R(1e-6);
+    if (new_goal || stopped || !c->has_time || cin->time < c->time_last ||
+        cin->v >= HM_R(0.5) * c->in.goal[3])
+        c->time_brisk = cin->time;
+    *slow = cin->time - c->time_brisk > p->stall_time;
+    if (new_goal || stopped || !c->has_time || cin->time < c->time_last) {
+        c->best_left = g->left;
+        c->time_progress = cin->time;
+        c->has_recovery = 0;
+    } else if (g->left < c->best_left - p->stall_distance) {
+        c->best_left = g->left;
+        c->time_progress = cin->time;
+    } else if (g->left > c->best_left) {
+        c->best_left = g->left;
+    }
+    c->has_goal = 1;
+    c->goal_xy[0] = g->final[0];
+    c->goal_xy[1] = g->final[1];
+    c->has_time = 1;
+    c->time_last = cin->time;
+    out->time_without_progress = cin->time - c->time_progress;
+    return out->time_without_progress > p->stall_time;
+}
