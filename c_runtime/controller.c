@@ -220,7 +220,10 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
     if (chosen != 0) {
         /* a candidate passes someone: the recoveries are for the main plan's standstills and loops */
         out->stalled = controller_progress(c, cin, &g, c->out.stop, &slow, out);
-        if (out->stalled) out->outcome = HM_OUTCOME_STALLED;
+        if (out->stalled) {
+            out->outcome = HM_OUTCOME_STALLED;
+            controller_stalled_command(c);
+        }
         return 0;
     }
     if (!c->out.stop && c->params.recovery_iterations > 0 && controller_plan_is_loop(c)) {
@@ -232,7 +235,10 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
         out->recovered = controller_recover_paced(c, cin, t0, CONTROLLER_START_TURN, out);
     if ((out->stalled || slow) && controller_may_recover(c, cin, out))
         out->recovered = controller_recover_paced(c, cin, t0, CONTROLLER_START_SIDEWAYS, out);
-    if (out->stalled) out->outcome = HM_OUTCOME_STALLED;
+    if (out->stalled) {
+        out->outcome = HM_OUTCOME_STALLED;
+        controller_stalled_command(c);
+    }
     return 0;
 }
 

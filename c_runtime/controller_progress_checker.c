@@ -7,6 +7,9 @@
  */
 #include "controller_progress_checker.h"
 
+#include "controller_goal_checker.h"
+#include "ocp_nlp_out.h"
+
 /* Progress towards the goal: the distance left must shrink by stall_distance within stall_time; a
  * path that grows (a replanned detour) restarts the measure, not the timer; a protective stop or a
  * new goal restarts both. Returns 1 when stalled; *slow: 1 when the robot has gone slower than half
@@ -38,4 +41,20 @@ HM_FUNC int controller_progress(hm_controller *c, const hm_controller_input *cin
     c->time_last = cin->time;
     out->time_without_progress = cin->time - c->time_progress;
     return out->time_without_progress > p->stall_time;
+}
+
+HM_FUNC int controller_stalled_command(hm_controller *c)
+{
+    hm_solver *s = &c->solver;
+    const hm_input *in = &c->in;
+    const hm_real v = c->out.command[0];
+    const hm_real towards = hm_cos(hm_atan2(in->goal[1] - in->x0[1], in->goal[0] - in->x0[0]) - in->x0[2]);
+    const int warm = s->warm;
+    if (c->out.stop || !(hm_fabs(v) > CONTROLLER_AT_REST) || v * towards > HM_R(0.0)) return 0;
+    ocp_nlp_protective_stop(s, in, &c->out, HM_STOP_NONE);
+    c->out.stop = 0;
+    /* the solver keeps its plan: a cold start from the braking state finds the same standstill (measured:
+     * braking and starting cold every stalled period held a robot for good) */
+    s->warm = warm;
+    return 1;
 }
