@@ -329,13 +329,14 @@ class ControllerNode(Node):
         return self._origin
 
     def _node_brake(self, header: Header, reason: str, detail: str) -> None:
-        """The node's own stop: the speed falls by the lower acceleration bound per period, no turning."""
+        """The node's own stop: the speed falls towards 0 per period by the acceleration bound that brakes in
+        its direction (a_bounds[0] moving forward, a_bounds[1] reversing), no turning."""
         if self.node_stop != reason:
             self.get_logger().warn(f"{REASON[reason].message}: {detail}")
         self.node_stop = reason
-        a_lo = float(self.ctl.params["a_bounds"][0])
+        a_lo, a_hi = (float(a) for a in self.ctl.params["a_bounds"])
         v = self.command[0]
-        v = max(0.0, v + a_lo * self.period) if v >= 0.0 else min(0.0, v - a_lo * self.period)
+        v = max(0.0, v + a_lo * self.period) if v >= 0.0 else min(0.0, v + a_hi * self.period)
         self.command = (v, 0.0)
         self._publish_cmd(header, v, 0.0)
 
