@@ -19,8 +19,9 @@ Checked: both goals reached; the protective stop topic reports the person within
 gives a stop with the node's reason and the commands brake the robot to a standstill; every command
 is finite. A JSON summary (latencies, the node's cycle times at 30 tracked people) goes to ~summary.
 
-The interpreter: tests/test_ros.py writes the project's venv Python into the first line; Debian's ROS
-Python packages are appended to sys.path (after the venv's, so the venv's numpy is used).
+The interpreter: tests/test_ros.py writes the project's venv Python into the first line; ROS 1's packages
+are imported from Debian's path ahead of the venv's (whose ROS 2 message packages share their names),
+numpy and humanmpc's dependencies from the venv.
 """
 
 from __future__ import annotations
@@ -34,24 +35,31 @@ import time
 import unittest
 from dataclasses import dataclass, field
 
-if "/usr/lib/python3/dist-packages" not in sys.path:
-    sys.path.append("/usr/lib/python3/dist-packages")
-
-import numpy as np
-import rospy
-import rostest
-import tf2_ros
-from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import PoseStamped, TransformStamped, Twist
-from humanmpc_msgs.msg import ProtectiveStop, TrackedPerson, TrackedPersons
-from nav_msgs.msg import Odometry, Path
-from sensor_msgs.msg import LaserScan
+import numpy as np  # the venv's, before Debian's packages are on the path
 
 from humanmpc.sim.crowd import Crowd, CrowdSpec
 from humanmpc.sim.robot import RobotLimits, RobotModel
 from humanmpc.sim.robot import step as robot_step
 from humanmpc.sim.social_force import SocialForceParams
 from humanmpc.sim.world import Polygon, World
+
+# ROS 1's packages from Debian's path, ahead of the venv's: the ros2 extra installs ROS 2's message packages
+# of the same names (rosgraph_msgs, std_msgs, geometry_msgs ...) into the venv, which rospy cannot use
+DEBIAN = "/usr/lib/python3/dist-packages"
+sys.path.insert(0, DEBIAN)
+for _shadowed in [m for m in sys.modules if m.split(".")[0].endswith("_msgs")]:
+    del sys.modules[_shadowed]
+import rospy  # noqa: E402
+import rostest  # noqa: E402
+import tf2_ros  # noqa: E402
+from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
+from geometry_msgs.msg import PoseStamped, TransformStamped, Twist  # noqa: E402
+from humanmpc_msgs.msg import ProtectiveStop, TrackedPerson, TrackedPersons  # noqa: E402
+from nav_msgs.msg import Odometry, Path  # noqa: E402
+from sensor_msgs.msg import LaserScan  # noqa: E402
+
+sys.path.remove(DEBIAN)
+sys.path.append(DEBIAN)  # anything imported later from the venv first
 
 SIM_DT = 0.02              # [s] robot integration, odometry and tf
 PEOPLE_EVERY = 5           # people and scan every 5 sim steps (10 Hz, the crowd model's period)
