@@ -106,7 +106,7 @@ class MPCPlanner:
         # every person as a track, as the tracker gave it (the C predicts); more than the controller holds:
         # the C keeps the nearest
         r = ctl.step(obs.time, pose=obs.x[:3], v=float(obs.x[3]), omega=self._omega, path=self._path(obs),
-                     goal=obs.goal[:3], people=obs.tracks, ids=np.arange(obs.n_humans), covariances=obs.human_covariances,
+                     goal=obs.goal[:3], people=obs.tracks, ids=obs.ids, covariances=obs.human_covariances,
                      obstacles=self._sensor.points(obs.x[:2]))
         self.last = r
         self._omega = float(r.command[1])
