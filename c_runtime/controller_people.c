@@ -89,6 +89,8 @@ HM_FUNC void controller_select_people(hm_real path[HM_N + 1][2], const hm_contro
         const hm_real *t = cin->tracks[out->people_index[j]];
         in->humans_now[j][0] = t[0];
         in->humans_now[j][1] = t[1];
+        in->humans_vel[j][0] = t[2];
+        in->humans_vel[j][1] = t[3];
         for (n = 0; n <= HM_N; n++) {
             const hm_real tau = HM_R(HM_DT) * (hm_real)n;
             in->humans_pred[n][j][0] = out->predictions[n][j][0] = t[0] + tau * t[2];

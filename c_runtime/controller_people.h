@@ -12,7 +12,8 @@
  * once per period for the two selections below (which only read it). */
 HM_FUNC void controller_expected_path(const hm_solver *s, const hm_controller_input *cin, hm_real path[HM_N + 1][2]);
 
-/* N_h tracks into the solver's input (in->n_humans, humans_now, humans_pred) and out (people_index,
+/* N_h tracks into the solver's input (in->n_humans, humans_now, humans_vel: the tracks' own, humans_pred:
+ * their constant-velocity predictions, made here and nowhere else) and out (people_index,
  * people_ids, predictions): first everyone within the stopping reach of a robot at up to v_cap (m/s) under
  * p (monitor_stopping_reach), nearest first; then those nearest to the robot's expected path over the
  * horizon (not only now). */

@@ -24,6 +24,13 @@ static int monitor_state_ok(const hm_real *x)
            hm_fabs(x[2]) <= HM_MONITOR_MAX_ANGLE && hm_fabs(x[3]) <= HM_MONITOR_MAX_SPEED;
 }
 
+/* A person's velocity: finite, each component within HM_MONITOR_MAX_SPEED (a comparison with NaN is
+ * false). */
+static int monitor_velocity_ok(const hm_real *v)
+{
+    return hm_fabs(v[0]) <= HM_MONITOR_MAX_SPEED && hm_fabs(v[1]) <= HM_MONITOR_MAX_SPEED;
+}
+
 /* The present humans' predicted positions, in one sweep without early exits (the step checks
  * (N + 1) N_h of them, twice): a comparison with NaN or an infinity is false, so the range test
  * alone also rejects non-finite entries. */
@@ -56,7 +63,7 @@ HM_FUNC int monitor_check_input(const hm_input *in, int check_x0)
     if (in->has_obstacle != 0 && in->has_obstacle != 1) return 0;
     if (in->has_obstacle && !monitor_position_ok(in->obstacle)) return 0;
     for (j = 0; j < in->n_humans; j++)
-        if (!monitor_position_ok(in->humans_now[j])) return 0;
+        if (!monitor_position_ok(in->humans_now[j]) || !monitor_velocity_ok(in->humans_vel[j])) return 0;
     return monitor_predictions_ok(in);
 }
 
@@ -143,7 +150,6 @@ HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_rea
 HM_FUNC hm_real monitor_separation_bound(const hm_input *in, const hm_params *p, const hm_real *x, int n,
                                          hm_real v_cap)
 {
-    const int k = n < HM_N ? n : HM_N - 1;
     const hm_real cos_t = hm_cos(x[2]), sin_t = hm_sin(x[2]);
     const hm_real a_brake = -p->a_bounds[0], t_r = p->reaction_time;
     hm_real bound = HM_INF, reach0, per_speed;
@@ -153,11 +159,9 @@ HM_FUNC hm_real monitor_separation_bound(const hm_input *in, const hm_params *p,
     monitor_separation_reach(p->d_h, t_r, a_brake, v_cap, &reach0, &per_speed);
     for (j = 0; j < ocp_nlp_clamp_humans(in); j++) {
         const hm_real *h = n == 0 ? in->humans_now[j] : in->humans_pred[n][j];
+        const hm_real *vh = in->humans_vel[j];
         const hm_real dx = h[0] - x[0], dy = h[1] - x[1];
-        hm_real vh[2];
         if (!monitor_separation_ahead(cos_t, sin_t, dx, dy)) continue;
-        vh[0] = (in->humans_pred[k + 1][j][0] - in->humans_pred[k][j][0]) / HM_R(HM_DT);
-        vh[1] = (in->humans_pred[k + 1][j][1] - in->humans_pred[k][j][1]) / HM_R(HM_DT);
         if (monitor_separation_far(dx, dy, vh, reach0, per_speed)) continue;
         bound = hm_fmin(bound, monitor_separation_root(cos_t, sin_t, dx, dy, vh, p->d_h, t_r, a_brake));
     }

@@ -2,7 +2,8 @@
  * monitor.h: the feasibility and safety monitors of the paper (section "Feasibility and Safety
  * Monitors") and the protective stop they command (ISO 3691-4, ISO 13482).
  *
- *   inputs  non-finite or absurd state, goal, humans, predictions, obstacle or parameters: nothing is
+ *   inputs  non-finite or absurd state, goal, humans (positions, velocities), predictions, obstacle or
+ *           parameters: nothing is
  *           computed from them.
  *   C1      the solver did not return a usable solution in time: the deadline passed (checked inside
  *           the QP iterations, not only around them), the QP was not solved (iteration limit,
@@ -11,8 +12,8 @@
  *           planned path comes within d_h of a present human's current position (its nodes 1..N,
  *           and the state reached by applying u0 from the measured state, by the model).
  *   separation  (params.separation) the commanded speed is above the speed from which braking after
- *           the reaction time stops the robot before a present human closing in at their predicted
- *           velocity comes within d_h (monitor_separation_speed). The OCP bounds its speeds the same
+ *           the reaction time stops the robot before a present human closing in at their velocity
+ *           (the input's humans_vel) comes within d_h (monitor_separation_speed). The OCP bounds its speeds the same
  *           way, so this fires when braking at the acceleration bound cannot keep the bound (a person
  *           appearing close, running at the robot) or for tracks the OCP does not see (the controller
  *           checks all of them).
@@ -68,8 +69,8 @@ HM_FUNC hm_real monitor_separation_speed(const hm_real *p, hm_real cos_t, hm_rea
 HM_FUNC hm_real monitor_stopping_reach(hm_real d_h, hm_real t_r, hm_real a_brake, hm_real v_cap, hm_real speed_h);
 
 /* The smallest monitor_separation_speed over the present humans of in, for a robot at x (heading x[2]):
- * each human at node n's prediction (their current position at n = 0), closing at the velocity of
- * their prediction over the interval from node n (the last interval's at n = N). HM_INF when none
+ * each human at node n's prediction (their current position at n = 0), closing at their velocity as
+ * the input gives it (humans_vel: the track's, whatever the prediction's shape). HM_INF when none
  * binds below v_cap. The OCP's bounds (ocp_nlp_lin.c) and the command's check below. */
 HM_FUNC hm_real monitor_separation_bound(const hm_input *in, const hm_params *p, const hm_real *x, int n,
                                          hm_real v_cap);

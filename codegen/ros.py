@@ -66,6 +66,17 @@ NODE_STOP_REASONS = (
                    "protective stop (node): a people message holds more tracks than the node's buffer"),
 )
 
+
+
+def node_stop_reason(name: str, table: tuple[NodeStopReason, ...] = NODE_STOP_REASONS) -> NodeStopReason:
+    """The row of the node's stop reason ``name`` (a KeyError naming the table's reasons otherwise): how the
+    nodes' code names a reason, so that the table is the only place its value and message are written."""
+    for r in table:
+        if r.name == name:
+            return r
+    raise KeyError(f"no node stop reason {name!r}; the table has {', '.join(r.name for r in table)}")
+
+
 # The most tracks one people message may hold (the node's buffer; the controller keeps the nearest
 # max_tracks of them). More is not a crowd but a broken tracker: a protective stop, too_many_tracks.
 NODE_MAX_TRACKS = 1024
@@ -194,7 +205,7 @@ def ros_context(spec: Spec) -> dict[str, Any]:
         "spec_hash": spec.digest(),
         "N": int(spec.horizon.N),
         "NT": int(spec.controller.max_tracks),
-        "NP": int(spec.controller.max_path_points),
+        "MAX_PATH_POINTS": int(spec.controller.max_path_points),
         "NK": int(spec.controller.max_obstacle_points),
         "dt": c_float(spec.dt),
         "params": params,

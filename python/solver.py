@@ -25,6 +25,12 @@ from .status import StatusEnums
 from .steplog import StepLog
 
 
+def implied_velocities(humans_pred: np.ndarray, dt: float) -> np.ndarray:
+    """(k, 2) velocities [vx, vy] m/s that predictions (N+1, k, 2) imply over their first interval: what
+    a caller without the people's velocities hands the solver (a constant-velocity prediction's own)."""
+    return np.asarray((humans_pred[1] - humans_pred[0]) / dt, dtype=np.float64)
+
+
 class Solver:
     """A generated solver, loaded with ``humanmpc.load(DIR)``."""
 
@@ -66,8 +72,11 @@ class Solver:
         self._counts = (0, False)   # what _in.n_humans, _in.has_obstacle hold (ffi.new zeroes them)
         # the first k humans' rows, for every k, as views made once
         h_now = c_array_view(ffi, self._in.humans_now, (nh_alloc, 2), rt)
+        h_vel = c_array_view(ffi, self._in.humans_vel, (nh_alloc, 2), rt)
         h_pred = c_array_view(ffi, self._in.humans_pred, (N + 1, nh_alloc, 2), rt)
+        self._dt = float(dims.dt)
         self._h_now_first = [h_now[:k] for k in range(nh_alloc + 1)]
+        self._h_vel_first = [h_vel[:k] for k in range(nh_alloc + 1)]
         self._h_pred_first = [h_pred[:, :k] for k in range(nh_alloc + 1)]
         self._out_buffer = ffi.buffer(self._out)
         self._out_dtype = record_dtype(ffi, f"{name}_output")
@@ -85,7 +94,8 @@ class Solver:
 
     # -- inputs -------------------------------------------------------------------------------
     def _load_inputs(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None,
-                     humans_pred: ArrayLike | None, obstacle: ArrayLike | None) -> None:
+                     humans_pred: ArrayLike | None, obstacle: ArrayLike | None,
+                     humans_vel: ArrayLike | None = None) -> None:
         nh = self._nh
         x0a = np.asarray(x0, dtype=np.float64)
         if x0a.shape != (4,):
@@ -111,6 +121,13 @@ class Solver:
             pred = np.asarray(humans_pred, dtype=np.float64)
             if pred.shape != (self._nodes, k, 2):
                 raise ValueError(f"humans_pred must have shape (N+1, k, 2) = ({self._nodes}, {k}, 2), got {pred.shape}")
+        if humans_vel is None:
+            vel = implied_velocities(pred, self._dt)
+        else:
+            vel = np.asarray(humans_vel, dtype=np.float64)
+            if vel.shape != (k, 2):
+                raise ValueError(f"humans_vel must have shape (k, 2) = ({k}, 2) [vx, vy] m/s, one row per person of "
+                                 f"humans_now, got {vel.shape}")
         has_obstacle = obstacle is not None
         if has_obstacle:
             oa = np.asarray(obstacle, dtype=np.float64)
@@ -129,6 +146,7 @@ class Solver:
             self._in.has_refs = int(per_node)
             self._has_refs = per_node
         self._h_now_first[k][...] = now
+        self._h_vel_first[k][...] = vel
         self._h_pred_first[k][...] = pred
         # the counts only when they change: a cffi attribute store costs as much as an array copy
         if (k, has_obstacle) != self._counts:
@@ -145,25 +163,31 @@ class Solver:
 
     # -- solving ------------------------------------------------------------------------------
     def step(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None = None,
-             humans_pred: ArrayLike | None = None, obstacle: ArrayLike | None = None) -> StepResult:
+             humans_pred: ArrayLike | None = None, obstacle: ArrayLike | None = None, *,
+             humans_vel: ArrayLike | None = None) -> StepResult:
         """One real-time iteration: preparation around the shifted previous plan, then feedback.
 
         goal: (4,) [gx, gy, gtheta, v_ref] for every node, or (N+1, 4) a goal per node (the progress
         objective's references along a path); humans_now: (k, 2) current positions, k <= N_h;
-        humans_pred: (N+1, k, 2) predicted positions at the nodes; obstacle: (2,) closest obstacle point
-        or None.
+        humans_pred: (N+1, k, 2) predicted positions at the nodes (the collision potential);
+        obstacle: (2,) closest obstacle point or None; humans_vel: (k, 2) the people's velocities
+        [vx, vy] m/s now (speed and separation: the OCP's speed bounds and the command's check). Without
+        humans_vel, the velocities the predictions imply over their first interval,
+        (humans_pred[1] - humans_pred[0]) / dt: a constant-velocity prediction's own.
         """
         with self._lock:
-            self._load_inputs(x0, goal, humans_now, humans_pred, obstacle)
+            self._load_inputs(x0, goal, humans_now, humans_pred, obstacle, humans_vel)
             self._c_step(self._solver, self._in, self._out)
             return self._result()
 
     def prepare(self, goal: ArrayLike, humans_now: ArrayLike | None = None, humans_pred: ArrayLike | None = None,
-                obstacle: ArrayLike | None = None, x0_guess: ArrayLike | None = None) -> None:
-        """The preparation phase alone (before the measurement): x0_guess is used only on a cold start."""
+                obstacle: ArrayLike | None = None, x0_guess: ArrayLike | None = None, *,
+                humans_vel: ArrayLike | None = None) -> None:
+        """The preparation phase alone (before the measurement): x0_guess is used only on a cold start;
+        the people as for ``step``."""
         with self._lock:
             guess = self._x0.copy() if x0_guess is None else x0_guess
-            self._load_inputs(guess, goal, humans_now, humans_pred, obstacle)
+            self._load_inputs(guess, goal, humans_now, humans_pred, obstacle, humans_vel)
             self._c_prepare(self._solver, self._in)
 
     def feedback(self, x0: ArrayLike) -> StepResult:
@@ -178,17 +202,17 @@ class Solver:
 
     def solve(self, x0: ArrayLike, goal: ArrayLike, humans_now: ArrayLike | None = None,
               humans_pred: ArrayLike | None = None, obstacle: ArrayLike | None = None, *,
-              max_iter: int = 100, tol: float = 1e-8) -> StepResult:
+              max_iter: int = 100, tol: float = 1e-8, humans_vel: ArrayLike | None = None) -> StepResult:
         """Full SQP to the KKT tolerance, from the current plan (after reset(): a cold start), under the
         monitors of ``step``: the deadline (``deadline_ms``: raise it for a reference solve), every QP
         solved (one stopped at its iteration limit ends the SQP in a stop, reason qp_failed), the clock,
-        C1 / C2 and the command guard."""
+        C1 / C2 and the command guard. The people as for ``step``."""
         if max_iter < 1:
             raise ValueError(f"max_iter must be >= 1, got {max_iter}")
         if not (math.isfinite(tol) and tol > 0):
             raise ValueError(f"tol must be a positive finite number, got {tol}")
         with self._lock:
-            self._load_inputs(x0, goal, humans_now, humans_pred, obstacle)
+            self._load_inputs(x0, goal, humans_now, humans_pred, obstacle, humans_vel)
             self._c_solve(self._solver, self._in, self._out, int(max_iter), float(tol))
             return self._result()
 

@@ -8,11 +8,8 @@ from pathlib import Path
 
 import pytest
 
+from .c_harness import SANITIZE, build_harness
 from .conftest import make_solver, require_tool
-
-C_DIR = Path(__file__).resolve().parent / "c"
-STRICT = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"]
-SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer", "-g"]
 
 
 @pytest.fixture(scope="module")
@@ -21,13 +18,7 @@ def soak_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def build_closed_loop(solver_dir: Path, out: Path, cc: str, flags: list[str]) -> Path:
-    name = solver_dir.name
-    cmd = [require_tool(cc), *STRICT, *flags, f'-DSOLVER_HEADER="{name}.h"', f"-DSOLVER_PREFIX={name}_",
-           "-I", str(solver_dir), str(C_DIR / "closed_loop.c"), str(solver_dir / f"{name}.c"),
-           str(solver_dir / f"{name}_model.c"), "-lm", "-o", str(out)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    assert proc.returncode == 0, proc.stderr
-    return out
+    return build_harness("closed_loop.c", solver_dir, out, cc, flags)
 
 
 def run_closed_loop(cmd: list[str], timeout: float) -> dict:
@@ -77,14 +68,8 @@ def test_profile_build_times_every_qp_part_and_the_parts_fit_in_the_step(soak_di
 
 def build_fuzzer(solver_dir: Path, exe: Path) -> Path:
     """tests/c/fuzz_step.c over a generated solver, with libFuzzer, ASan and UBSan (docs/reliability.md)."""
-    name = solver_dir.name
-    cmd = [require_tool("clang"), *STRICT, "-O1", "-g", "-fsanitize=fuzzer,address,undefined",
-           "-fno-sanitize-recover=all", f'-DSOLVER_HEADER="{name}.h"', f"-DSOLVER_PREFIX={name}_",
-           f"-DSOLVER_UPREFIX={name.upper()}_", "-I", str(solver_dir), str(C_DIR / "fuzz_step.c"),
-           str(solver_dir / f"{name}.c"), str(solver_dir / f"{name}_model.c"), "-lm", "-o", str(exe)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    assert proc.returncode == 0, proc.stderr
-    return exe
+    return build_harness("fuzz_step.c", solver_dir, exe, "clang",
+                         ["-O1", "-g", "-fsanitize=fuzzer,address,undefined", "-fno-sanitize-recover=all"])
 
 
 def test_libfuzzer_over_step_feedback_solve_reset_parameters_and_clock_finds_nothing(tmp_path: Path) -> None:

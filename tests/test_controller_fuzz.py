@@ -14,11 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from .conftest import make_solver, require_tool
-
-C_DIR = Path(__file__).resolve().parent / "c"
-STRICT = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", "-D_DEFAULT_SOURCE"]
-SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer", "-g"]
+from .c_harness import SANITIZE, build_harness
+from .conftest import make_solver
 
 
 @pytest.fixture(scope="module")
@@ -28,13 +25,7 @@ def fuzz_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def build(solver_dir: Path, exe: Path, cc: str, flags: list[str]) -> Path:
-    name = solver_dir.name
-    cmd = [require_tool(cc), *STRICT, *flags, f'-DSOLVER_HEADER="{name}.h"', f"-DSOLVER_PREFIX={name}_",
-           f"-DSOLVER_UPREFIX={name.upper()}_", "-I", str(solver_dir), str(C_DIR / "fuzz_controller.c"),
-           str(solver_dir / f"{name}.c"), str(solver_dir / f"{name}_model.c"), "-lm", "-o", str(exe)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    assert proc.returncode == 0, proc.stderr
-    return exe
+    return build_harness("fuzz_controller.c", solver_dir, exe, cc, ["-D_DEFAULT_SOURCE", *flags])
 
 
 def run(exe: Path, steps: int, seed: int, timeout: float) -> dict[str, int]:

@@ -48,6 +48,8 @@ static void load_c(int t)
     for (int j = 0; j < k; j++) {
         c_in.humans_now[j][0] = replay_humans_now[row + j][0];
         c_in.humans_now[j][1] = replay_humans_now[row + j][1];
+        c_in.humans_vel[j][0] = replay_humans_vel[row + j][0];
+        c_in.humans_vel[j][1] = replay_humans_vel[row + j][1];
         for (int n = 0; n <= NAME::N; n++) {
             c_in.humans_pred[n][j][0] = replay_humans_pred[row + j][n][0];
             c_in.humans_pred[n][j][1] = replay_humans_pred[row + j][n][1];
@@ -67,6 +69,7 @@ static void load_face(int t)
     face.n_humans() = k;
     for (int j = 0; j < k; j++) {
         face.humans_now().col(j) = CPoint(replay_humans_now[row + j]);
+        face.humans_vel().col(j) = CPoint(replay_humans_vel[row + j]);
         for (int n = 0; n <= NAME::N; n++) face.humans_pred(n).col(j) = CPoint(replay_humans_pred[row + j][n]);
     }
     face.has_obstacle() = replay_has_obstacle[t];
@@ -90,6 +93,7 @@ int main()
 
     /* views, not copies: every map points into the C structs */
     if (face.x0().data() != face.input().x0 || face.humans_pred(3).data() != &face.input().humans_pred[3][0][0] ||
+        face.humans_vel().data() != &face.input().humans_vel[0][0] ||
         face.humans_pred().data() != &face.input().humans_pred[0][0][0] || face.u0().data() != face.output().u0 ||
         face.x().data() != &face.output().x[0][0] || face.u().data() != &face.output().u[0][0]) {
         std::printf("error: a map is not a view of the C struct\n");

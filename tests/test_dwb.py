@@ -23,7 +23,7 @@ def _scene(world: World, start: tuple[float, float], goal: tuple[float, float], 
 def _obs(x: list[float], humans: np.ndarray, world: World | None = None) -> Observation:
     return Observation(
         time=0.0, x=np.array(x), goal=np.array([5.0, 0.0, 0.0, 0.8]), humans_now=humans,
-        humans_pred=np.repeat(humans[None], 51, axis=0), obstacle=np.array([1e3, 0.0]),
+        humans_velocity=np.zeros_like(humans), obstacle=np.array([1e3, 0.0]),
         world=world or World(), dt=0.1,
     )
 

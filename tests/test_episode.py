@@ -9,18 +9,21 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from humanmpc.eval.commands import add_evaluate_parser, add_simulate_parser
-from humanmpc.eval.episode import run_episode
+import humanmpc
+from humanmpc.eval.commands import add_evaluate_parser, add_simulate_parser, choose_solver
+from humanmpc.eval.episode import EpisodeConfig, run_episode
 from humanmpc.eval.evaluate import evaluate
 from humanmpc.eval.metrics import compute_metrics
 from humanmpc.eval.plots import animate_episode, plot_episodes
+from humanmpc.planners import solver_cache
 from humanmpc.planners.dwb import DWBPlanner
+from humanmpc.planners.mpc import MPCPlanner
 from humanmpc.planners.registry import make_planner, planner_names, register_planner
 from humanmpc.sim.scenarios import make_scenario
-from tests.conftest import Recorder
+from tests.conftest import Recorder, make_solver
 
 
-def test_episode_feeds_observations_and_predictions_and_logs_consistently() -> None:
+def test_episode_feeds_observations_as_tracks_and_logs_consistently() -> None:
     scenario = make_scenario("random_crowded_cluttered", 1)
     rec = Recorder()
     log = run_episode(scenario, rec)
@@ -30,12 +33,31 @@ def test_episode_feeds_observations_and_predictions_and_logs_consistently() -> N
     for t in (0, 5, T - 1):
         obs = rec.seen[t]
         np.testing.assert_allclose(obs.humans_now, log.humans[t])
-        assert obs.humans_pred.shape == (51, 10, 2)
-        np.testing.assert_allclose(obs.humans_pred[0], obs.humans_now)
+        assert obs.humans_velocity.shape == (10, 2) and obs.tracks.shape == (10, 4)
+        np.testing.assert_array_equal(obs.ids, np.arange(10))
         np.testing.assert_allclose(obs.obstacle, scenario.world.nearest_point(log.states[t, :2]))
-    # the prediction's velocity is the finite difference of the last two observations
+    # the track's velocity is the finite difference of the last two observations
     v_obs = (log.humans[5] - log.humans[4]) / 0.1
-    np.testing.assert_allclose(rec.seen[5].humans_pred[10], log.humans[5] + 1.0 * v_obs, atol=1e-9)
+    np.testing.assert_allclose(rec.seen[5].humans_velocity, v_obs, atol=1e-9)
+
+
+def test_the_evaluation_runs_a_solver_whose_horizon_is_not_the_default_one(tmp_path: Path) -> None:
+    """The episode hands tracks, which the controller predicts over its own N: an MPC planner over an N = 20
+    solver runs in the evaluation's default settings (they once had to carry N = 50's horizon), and choosing
+    that solver leaves the settings as they are."""
+    spec = tmp_path / "n20.yaml"
+    spec.write_text("name: n20\nhorizon: {T: 2.0, N: 20}\nhumans: {max: 3}\n")
+    solver_dir = make_solver(tmp_path, {"name": "n20", "horizon": {"T": 2.0, "N": 20}, "humans": {"max": 3}})
+    try:
+        assert choose_solver(spec, solver_dir) == EpisodeConfig()
+    finally:
+        solver_cache.select_solver()  # choose_solver chose this process's solver; back to the default
+    planner = MPCPlanner(humanmpc.load(solver_dir))
+    assert planner.controller.dims.N == 20
+    log = run_episode(make_scenario("crossing_group", 0), planner, EpisodeConfig())
+    assert log.steps > 50 and log.ended_by in {"goal", "time_limit"}
+    assert planner.last is not None and planner.last.plan.shape == (21, 4)
+    assert np.all(np.isfinite(log.controls))
 
 
 def test_dwb_episode_runs_end_to_end_and_its_plots_are_written(tmp_path: Path) -> None:

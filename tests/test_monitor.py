@@ -25,6 +25,7 @@ def clean_inputs() -> dict:
         "humans_now": humans_now,
         "humans_pred": pred,
         "obstacle": np.array([4.0, -0.8]),
+        "humans_vel": vel,
     }
 
 
@@ -97,17 +98,49 @@ def test_person_running_at_the_robot_stops_it_for_separation_and_it_resumes_afte
     solver = humanmpc.load(default_dir)  # speed and separation on (the default spec)
     inp = clean_inputs()
     assert not solver.step(**inp).stop
-    run = dict(inp, humans_now=inp["humans_now"].copy(), humans_pred=inp["humans_pred"].copy())
-    # 1.5 m ahead, running at the robot at 3 m/s: the person alone covers 0.9 m of the 1.0 m gap while the
-    # robot reacts (0.3 s); no speed above 0.03 m/s keeps the separation, and braking reaches 0.5 m/s
-    run["humans_now"][0] = inp["x0"][:2] + 1.5 * np.array([np.cos(0.1), np.sin(0.1)])
-    run["humans_pred"][:, 0] = run["humans_now"][0] - 3.0 * np.array([np.cos(0.1), np.sin(0.1)]) * DT * \
-        np.arange(N + 1)[:, None]
+    run = running_at_the_robot(inp)
     r = solver.step(**run)
     assert r.reason == "separation" and r.stop_reason == 8
     assert_braking(r, solver, v0=inp["x0"][3])
     r = solver.step(**inp)
     assert not r.stop and r.status_name == "solved"
+
+
+def running_at_the_robot(inp: dict) -> dict:
+    """inp with person 0 1.5 m ahead, running at the robot at 3 m/s (velocity and prediction): the person
+    alone covers 0.9 m of the 1.0 m gap while the robot reacts (0.3 s); no speed above 0.03 m/s keeps the
+    separation, and braking reaches 0.5 m/s."""
+    heading = np.array([np.cos(0.1), np.sin(0.1)])
+    run = {k: np.array(v, dtype=float) for k, v in inp.items()}
+    run["humans_now"][0] = inp["x0"][:2] + 1.5 * heading
+    run["humans_vel"][0] = -3.0 * heading
+    run["humans_pred"][:, 0] = run["humans_now"][0] + run["humans_vel"][0] * DT * np.arange(N + 1)[:, None]
+    return run
+
+
+def test_the_separation_monitor_takes_the_velocity_given_not_the_predictions_slope(default_dir: Path) -> None:
+    """Speed and separation close in at the input's humans_vel: a person predicted to stand but running at
+    the robot stops it; one predicted to run at it but standing does not stop it for separation."""
+    run = running_at_the_robot(clean_inputs())
+    standing = run["humans_now"][0]
+    predicted_standing = {k: v.copy() for k, v in run.items()}
+    predicted_standing["humans_pred"][:, 0] = standing  # the prediction says nothing about the running
+    r = humanmpc.load(default_dir).step(**predicted_standing)
+    assert r.reason == "separation" and r.stop_reason == 8
+    running_prediction = {k: v.copy() for k, v in run.items()}
+    running_prediction["humans_vel"][0] = 0.0  # the tracker says they stand; the prediction runs at the robot
+    r = humanmpc.load(default_dir).step(**running_prediction)
+    assert r.reason != "separation"
+
+
+def test_without_velocities_the_solver_takes_those_of_the_predictions_first_interval(default_dir: Path) -> None:
+    inp = running_at_the_robot(clean_inputs())
+    given = dict(inp, humans_vel=(inp["humans_pred"][1] - inp["humans_pred"][0]) / DT)
+    without = {k: v for k, v in inp.items() if k != "humans_vel"}
+    assert_same(humanmpc.load(default_dir).step(**without), humanmpc.load(default_dir).step(**given))
+    assert humanmpc.load(default_dir).step(**without).reason == "separation"
+    with pytest.raises(ValueError, match=r"humans_vel must have shape \(k, 2\) = \(3, 2\)"):
+        humanmpc.load(default_dir).step(**dict(inp, humans_vel=np.zeros((2, 2))))
 
 
 def test_one_microsecond_deadline_stops_inside_the_qp_and_clears(fresh: humanmpc.Solver) -> None:
@@ -127,6 +160,8 @@ def test_one_microsecond_deadline_stops_inside_the_qp_and_clears(fresh: humanmpc
 FIELDS = [("x0", (i,)) for i in range(4)] + [("goal", (i,)) for i in range(4)] + [
     ("humans_now", (j, k)) for j in range(3) for k in range(2)
 ] + [("humans_pred", (n, j, k)) for n in (0, 17, 50) for j in range(3) for k in range(2)] + [
+    ("humans_vel", (j, k)) for j in range(3) for k in range(2)
+] + [
     ("obstacle", (k,)) for k in range(2)
 ]
 

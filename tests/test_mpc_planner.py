@@ -34,9 +34,8 @@ def observation(x: list[float] | np.ndarray, goal: list[float], world: World = W
                 humans: np.ndarray | None = None, velocities: np.ndarray | None = None) -> Observation:
     now = np.zeros((0, 2)) if humans is None else humans
     vel = np.zeros_like(now) if velocities is None else velocities
-    pred = now[None] + vel[None] * (0.1 * np.arange(51))[:, None, None]
     return Observation(
-        time=time, x=np.array(x, dtype=float), goal=np.array(goal, dtype=float), humans_now=now, humans_pred=pred,
+        time=time, x=np.array(x, dtype=float), goal=np.array(goal, dtype=float), humans_now=now, humans_velocity=vel,
         obstacle=world.obstacle_parameter(np.asarray(x[:2], dtype=float)), world=world, dt=0.1,
     )
 

@@ -176,10 +176,11 @@ def test_an_episode_among_recorded_people_logs_who_is_present_and_shows_only_the
     assert np.all(np.isnan(log.humans[~present])) and np.all(np.isfinite(log.humans[present]))
     for t, obs in enumerate(planner.seen):
         np.testing.assert_allclose(obs.humans_now, log.humans[t, present[t]])
-        assert obs.humans_pred.shape == (51, int(present[t].sum()), 2)
-    # at 1.6 s track 1 appears (one observation): predicted to stand; at 1.7 s it walks at 1 m/s
-    np.testing.assert_allclose(planner.seen[16].humans_pred[10], [[1.6, 0.0]])
-    np.testing.assert_allclose(planner.seen[17].humans_pred[10], [[2.7, 0.0]], atol=1e-9)
+        assert obs.humans_velocity.shape == (int(present[t].sum()), 2)
+        np.testing.assert_array_equal(obs.ids, log.human_ids[present[t]])
+    # at 1.6 s track 1 appears (one observation): it stands; at 1.7 s it walks at 1 m/s
+    np.testing.assert_allclose(planner.seen[16].humans_velocity, [[0.0, 0.0]])
+    np.testing.assert_allclose(planner.seen[17].humans_velocity, [[1.0, 0.0]], atol=1e-9)
     m = compute_metrics(log)
     # nearest person: track 0 at 3.0 m when the robot starts (both at x = 0), never anyone absent
     assert m.min_human_distance == pytest.approx(3.0) and m.collisions == 0

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import signal
 import socket
@@ -26,7 +27,15 @@ import yaml
 from humanmpc.cli import main as cli_main
 from humanmpc.codegen.generate import GenerateError
 from humanmpc.codegen.params import PARAMS
-from humanmpc.codegen.ros import MSGS_PACKAGE, NODE_MAX_TRACKS, NODE_STOP_REASONS, ROS_MARKER, write_ros
+from humanmpc.codegen.ros import (
+    MSGS_PACKAGE,
+    NODE_MAX_TRACKS,
+    NODE_STOP_REASONS,
+    ROS_MARKER,
+    node_stop_reason,
+    write_ros,
+)
+from humanmpc.codegen.ros2 import NODE2_STOP_REASONS
 from humanmpc.codegen.status import status_tables
 from tests.conftest import REPO_ROOT, make_solver, require_tool
 
@@ -45,6 +54,17 @@ def require_debian() -> None:
 @pytest.fixture(scope="module")
 def solver_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return make_solver(tmp_path_factory.mktemp("ros_solver"), built=False)
+
+
+def test_the_nodes_name_their_stop_reasons_from_the_one_table() -> None:
+    """The ROS 2 node's reasons are the ROS 1 node's rows (only the frame's message reworded: no tf2), and a
+    reason the table lacks is refused with the table's names."""
+    assert [(r.id, r.value, r.name) for r in NODE2_STOP_REASONS] == [(r.id, r.value, r.name) for r in NODE_STOP_REASONS]
+    assert [r.name for r in NODE_STOP_REASONS if r not in NODE2_STOP_REASONS] == ["no_transform"]
+    assert node_stop_reason("stale_scan").value == 103
+    assert node_stop_reason("no_transform", NODE2_STOP_REASONS).message != node_stop_reason("no_transform").message
+    with pytest.raises(KeyError, match="no node stop reason 'stale'; the table has stale_odometry, stale_people"):
+        node_stop_reason("stale")
 
 
 def test_ros_command_writes_the_message_and_node_packages_beside_the_solver(solver_dir: Path,
@@ -66,6 +86,8 @@ def test_ros_command_writes_the_message_and_node_packages_beside_the_solver(solv
     assert config["control_period"] == pytest.approx(0.1)
     for p in PARAMS:
         assert f'pnh_.getParam("{p.name}", v)' in node
+    # the path's capacity is the header's macro, not a number (nor an NP) of the template's own
+    assert "std::min<std::size_t>(n, PAPER_MAX_PATH_POINTS)" in node and not re.search(r"\bNP\b", node)
     # the solver travels with the node: its C sources, not its build folder
     assert (out / "paper_ros" / "solver" / "paper.c").is_file()
     assert (out / "paper_ros" / "solver" / "manifest.json").is_file()

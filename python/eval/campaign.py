@@ -200,7 +200,7 @@ class Campaign:
             "grid": {n: [list(v) if isinstance(v, tuple) else v for v in values] for n, values in self.grid},
             "seeds": list(self.seeds), "spec_digest": self.solver.digest,
             "solver_dir": self.solver.solver_dir, "traces": self.traces,
-            "episode": {"dt": cfg.dt, "horizon": cfg.horizon, "stop_on_collision": cfg.stop_on_collision,
+            "episode": {"dt": cfg.dt, "stop_on_collision": cfg.stop_on_collision,
                         "robot": asdict(cfg.robot), "social_force": asdict(cfg.social_force),
                         "orca": asdict(cfg.orca)},
         }

@@ -17,8 +17,8 @@ The three commands take ``--spec FILE`` and ``--solver-dir DIR`` for the solver 
 their cache, ``generated/.cache/<name>-<hash>/`` (reused while the spec is unchanged); ``--solver-dir``
 uses a generated and built package as it is, never regenerating or rebuilding it (with ``--spec`` as
 well, it must hold that spec's solver); neither, the built-in default spec's solver in the cache
-(:mod:`humanmpc.planners.solver_cache`). The episodes' prediction horizon is the solver's N; its
-interval T / N must be the simulation's control period, 0.1 s.
+(:mod:`humanmpc.planners.solver_cache`). The solver's interval T / N must be the simulation's control
+period, 0.1 s (its N is its own: the episodes hand the planners tracks, which the controller predicts).
 """
 
 from __future__ import annotations
@@ -55,11 +55,10 @@ def choose_solver(spec_file: Path | None, solver_dir: Path | None) -> EpisodeCon
         N, dt, where = resolved.horizon.N, resolved.dt, str(spec_file or "the built-in spec")
     base = EpisodeConfig()
     if abs(dt - base.dt) > 1e-9:
-        raise ValueError(f"{where}: horizon.T / horizon.N = {dt:g} s, but the simulation's control period and the "
-                         f"spacing of its predictions are {base.dt:g} s: give horizon.T = {base.dt:g} * horizon.N "
-                         f"(T: {base.dt * N:g} for N: {N})")
+        raise ValueError(f"{where}: horizon.T / horizon.N = {dt:g} s, but the simulation's control period is "
+                         f"{base.dt:g} s: give horizon.T = {base.dt:g} * horizon.N (T: {base.dt * N:g} for N: {N})")
     select_solver(spec, solver_dir, source)
-    return replace(base, horizon=N)
+    return base
 
 
 def _print_solver(planner: object) -> None:

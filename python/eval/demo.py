@@ -59,7 +59,7 @@ def timing_summary(logs: dict[str, EpisodeLog]) -> str:
 
 def run_demo(seed: int = 0, out_dir: Path = Path("out/demo"), scenario_name: str = SCENARIO,
              config: EpisodeConfig | None = None) -> Path:
-    """The demo with the chosen solver; ``config``: the episodes' settings (its horizon the solver's N)."""
+    """The demo with the chosen solver; ``config``: the episodes' settings."""
     say = lambda m: print(m, file=sys.stderr)  # noqa: E731
     started = time.perf_counter()
     scenario = make_scenario(scenario_name, seed)  # a wrong name or seed fails before the solver is built

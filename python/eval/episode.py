@@ -2,8 +2,10 @@
 
 Per step (period ``dt``, 0.1 s by default):
 
-1. observe the humans' positions (exact, no sensor noise) and predict them over the horizon
-   from the observations only;
+1. observe the humans' positions (exact, no sensor noise) and track them: each person's velocity
+   from their observations only (the tracker); the planner gets tracks (positions, velocities,
+   ids), never predicted paths: the MPC planner's controller predicts in C, a planner that wants
+   predictions makes them itself;
 2. select the obstacle point: the nearest point of the nearest static obstacle to the robot,
    chosen anew every step;
 3. call the planner with an :class:`~humanmpc.planners.interface.Observation`;
@@ -20,7 +22,7 @@ The people present may change within an episode (recorded crowds: people enter a
 recorded). The log keeps everyone who was ever present, in the order of their ids: ``humans``
 (T + 1, K, 2) holds NaN where a person is absent and ``present`` (T + 1, K) says who is there;
 metrics and figures use the mask (the NaN makes any use that forgets it visible, where a
-placeholder position would silently count). The predictor is given the ids, so a person's
+placeholder position would silently count). The tracker is given the ids, so a person's
 velocity is estimated from that person's own observations.
 
 The episode ends when the robot's centre is within the scenario's ``goal_tolerance`` of the
@@ -40,7 +42,7 @@ from numpy.typing import NDArray
 from ..planners.interface import Observation, Planner
 from ..sim.crowd import ReactiveCrowd
 from ..sim.orca import OrcaParams
-from ..sim.predict import ConstantVelocityPredictor, Predictor
+from ..sim.predict import ConstantVelocityTracker, Tracker
 from ..sim.robot import RobotModel, step, velocity_vector
 from ..sim.scenarios import CROWD_MODELS, Scenario
 from ..sim.social_force import SocialForceParams
@@ -54,7 +56,6 @@ class EpisodeConfig:
     """Loop settings shared by every planner of an evaluation."""
 
     dt: float = 0.1
-    horizon: int = 50
     robot: RobotModel = field(default_factory=RobotModel)
     social_force: SocialForceParams = field(default_factory=SocialForceParams)
     stop_on_collision: bool = False
@@ -162,12 +163,12 @@ def run_episode(
     scenario: Scenario,
     planner: Planner,
     config: EpisodeConfig | None = None,
-    predictor: Predictor | None = None,
+    tracker: Tracker | None = None,
 ) -> EpisodeLog:
     """Run ``planner`` on ``scenario`` until goal, time limit (or first contact, if asked)."""
     cfg = config or EpisodeConfig()
-    pred = predictor or ConstantVelocityPredictor(cfg.horizon, cfg.dt)
-    pred.reset()
+    tracks = tracker or ConstantVelocityTracker()
+    tracks.reset()
     planner.reset()
     crowd = scenario.start_crowd(cfg.social_force, cfg.crowd_model, cfg.orca)
     reactive = crowd if isinstance(crowd, ReactiveCrowd) else None  # simulated people react to the robot
@@ -187,9 +188,10 @@ def run_episode(
     ended_by = "time_limit"
     for _ in range(n_steps):
         humans_now = humans[-1].copy()
-        humans_pred = pred.observe(t, humans_now, ids[-1])
+        humans_velocity = tracks.observe(t, humans_now, ids[-1])
         obstacle = world.obstacle_parameter(x[:2])
-        obs = Observation(t, x.copy(), goal.copy(), humans_now, humans_pred, obstacle, world, cfg.dt, robot)
+        obs = Observation(t, x.copy(), goal.copy(), humans_now, humans_velocity, obstacle, world, cfg.dt, robot,
+                          human_ids=np.asarray(ids[-1], dtype=np.int64))
         t0 = time.perf_counter()
         result = planner.plan(obs)
         wall_ms = (time.perf_counter() - t0) * 1e3

@@ -234,7 +234,7 @@ def evaluate(
     their per-step trace (``first`` seed, ``all``, ``none``; the figures need the first); ``fresh``: delete
     another campaign's results in ``out_dir`` instead of refusing; ``flush_every``: episodes per Parquet part
     (a part is also written every 10 s). ``config``: the episodes' settings
-    (default ``EpisodeConfig()``; its horizon must be the MPC solver's N)."""
+    (default ``EpisodeConfig()``; its dt must be the MPC solver's interval)."""
     validate_names(scenarios, planners, seeds)
     if not seeds:
         raise ValueError("evaluate needs at least one seed")

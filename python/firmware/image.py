@@ -38,6 +38,7 @@ from ..codegen import __version__
 from ..codegen.build import read_manifest
 from ..codegen.render import make_environment
 from ..codegen.spec import Spec, load_spec
+from ..solver import implied_velocities
 
 if TYPE_CHECKING:
     from ..compare.replay import Replay
@@ -227,6 +228,9 @@ def replay_context(replay: Replay, real: str) -> dict[str, Any]:
     now = np.concatenate([replay.humans_now[t, :k] for t, k in enumerate(ks)]) if sum(ks) else np.zeros((0, 2))
     pred = (np.concatenate([replay.humans_pred[t, :, :k].transpose(1, 0, 2) for t, k in enumerate(ks)])
             if sum(ks) else np.zeros((0, replay.N + 1, 2)))
+    # the replay holds predictions only: the velocities the host's Solver.step derives from them
+    vel = (np.concatenate([implied_velocities(replay.humans_pred[t, :, :k], replay.dt) for t, k in enumerate(ks)])
+           if sum(ks) else np.zeros((0, 2)))
     params = []
     for key, value in replay.params.items():
         if isinstance(value, list | tuple):
@@ -244,6 +248,7 @@ def replay_context(replay: Replay, real: str) -> dict[str, Any]:
         "goal": _rows(replay.goal, real, 4),
         "obstacle": _rows(replay.obstacle, real, 2),
         "humans_now": _rows(now, real, 2),
+        "humans_vel": _rows(vel, real, 2),
         "humans_pred": _pred_rows(pred, real),
         "params": params,
     }

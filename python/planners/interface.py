@@ -1,10 +1,11 @@
 """The interface every local planner of the evaluation implements (DWB baseline, MPC adapter).
 
 Per control step the closed loop hands the planner an :class:`Observation` and applies the
-returned :class:`PlanResult`'s ``u = (a, omega)`` for one period ``dt``. The fields mirror the
-generated solver's ``step(x0, goal, humans_now, humans_pred, obstacle)`` inputs and its
-``u0 / command / x / u / status / stop / reason / timings`` outputs, so an MPC adapter is a
-one-to-one copy.
+returned :class:`PlanResult`'s ``u = (a, omega)`` for one period ``dt``. The people come as tracks
+(position, velocity, id, optionally a position covariance), what a robot's tracker hands its
+navigation stack; a planner that wants predicted paths makes them itself
+(:func:`humanmpc.sim.predict.predict_constant_velocity`). The outputs mirror the generated
+controller's ``u / command / plan / controls / stop / reason / timings``.
 """
 
 from __future__ import annotations
@@ -26,37 +27,56 @@ FloatArray = NDArray[np.float64]
 class Observation:
     """What a planner knows at one control step.
 
-    x            robot state [px, py, theta, v] (4,)
-    goal         [gx, gy, gtheta, v_ref] (4,), v_ref the preferred cruising speed
-    humans_now   observed human positions (k, 2)
-    humans_pred  predicted positions at the nodes n = 0..N (N + 1, k, 2), node 0 = humans_now
-    obstacle     nearest point of the nearest static obstacle to the robot (2,)
-    world        all static obstacles, for planners that want more than the nearest point
-    dt           control period (s); the node spacing of humans_pred as well
-    robot        the robot's limits and radii
+    x                  robot state [px, py, theta, v] (4,)
+    goal               [gx, gy, gtheta, v_ref] (4,), v_ref the preferred cruising speed
+    humans_now         the people's tracked positions (k, 2) [m]
+    humans_velocity    their tracked velocities (k, 2) [m/s]
+    obstacle           nearest point of the nearest static obstacle to the robot (2,)
+    world              all static obstacles, for planners that want more than the nearest point
+    dt                 control period (s)
+    robot              the robot's limits and radii
+    human_ids          the tracker's id of each person (k,); None: 0..k-1
+    human_covariances  position covariances [sxx, sxy, syy] (k, 3) [m^2], if the tracker gives them
     """
 
     time: float
     x: FloatArray
     goal: FloatArray
     humans_now: FloatArray
-    humans_pred: FloatArray
+    humans_velocity: FloatArray
     obstacle: FloatArray
     world: World
     dt: float
     robot: RobotModel = field(default_factory=RobotModel)
+    human_ids: NDArray[np.int64] | None = None
+    human_covariances: FloatArray | None = None
 
-    @property
-    def humans_velocity(self) -> FloatArray:
-        """The tracker's velocity estimate of each human (k, 2) [m/s]: the slope of the constant-velocity
-        prediction over its first interval."""
-        if self.humans_pred.shape[0] < 2:
-            return np.zeros_like(self.humans_now)
-        return (self.humans_pred[1] - self.humans_pred[0]) / self.dt
+    def __post_init__(self) -> None:
+        k = self.humans_now.shape[0]
+        if self.humans_now.shape != (k, 2) or self.humans_velocity.shape != (k, 2):
+            raise ValueError(f"Observation: humans_now and humans_velocity must both have shape (k, 2), got "
+                             f"{self.humans_now.shape} and {self.humans_velocity.shape}")
+        if self.human_ids is not None and np.shape(self.human_ids) != (k,):
+            raise ValueError(f"Observation: human_ids must have shape ({k},), got {np.shape(self.human_ids)}")
+        if self.human_covariances is not None and np.shape(self.human_covariances) != (k, 3):
+            raise ValueError(f"Observation: human_covariances must have shape ({k}, 3), got "
+                             f"{np.shape(self.human_covariances)}")
 
     @property
     def n_humans(self) -> int:
         return int(self.humans_now.shape[0])
+
+    @property
+    def ids(self) -> NDArray[np.int64]:
+        """The people's ids (k,): the tracker's, or 0..k-1 without them."""
+        if self.human_ids is None:
+            return np.arange(self.n_humans, dtype=np.int64)
+        return np.asarray(self.human_ids, dtype=np.int64)
+
+    @property
+    def tracks(self) -> FloatArray:
+        """The people as tracks [x, y, vx, vy] (k, 4), the controller's form."""
+        return np.hstack([self.humans_now, self.humans_velocity])
 
 
 @dataclass(frozen=True)

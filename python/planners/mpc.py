@@ -8,8 +8,8 @@ nodes embed. What it hands over:
 - the path: the global planner's (:class:`~humanmpc.planners.global_path.GlobalPlanner`, A* on the
   static map replanned at 1 Hz, the role nav2's planner server plays; the DWB baseline gets the same
   path), or with ``global_path=False`` only the goal pose;
-- the people as tracks ``[x, y, vx, vy]``: their positions and the episode's constant-velocity
-  estimate of their velocities (the tracker);
+- the people as the episode's tracks ``[x, y, vx, vy]`` with their ids (and covariances, if given):
+  positions and the episode tracker's velocities; the controller predicts their paths, once, in C;
 - the obstacles as points: the static obstacles' boundary within sensor range (a scan's returns,
   :class:`~humanmpc.sim.sensors.ObstacleSensor`);
 - the odometry and the time.
@@ -96,17 +96,17 @@ class MPCPlanner:
 
     def plan(self, obs: Observation) -> PlanResult:
         ctl = self.controller
-        if obs.humans_pred.shape[0] != ctl.dims.N + 1 or abs(obs.dt - ctl.dims.dt) > 1e-9:
-            raise ValueError(f"the episode predicts {obs.humans_pred.shape[0] - 1} intervals of {obs.dt} s; "
-                             f"the controller needs {ctl.dims.N} of {ctl.dims.dt} s (EpisodeConfig(horizon, dt))")
+        if abs(obs.dt - ctl.dims.dt) > 1e-9:
+            raise ValueError(f"the episode's control period is {obs.dt} s; the controller's interval is "
+                             f"{ctl.dims.dt} s (horizon.T / horizon.N of its spec)")
         if abs(float(obs.goal[3]) - ctl.params["v_ref"]) > 1e-12:  # the episode's cruising speed, DWB's cap too
             ctl.set_params(v_ref=float(obs.goal[3]), speed_limit=float(obs.goal[3]))
         if self._sensor is None or self._sensor.world is not obs.world:
             self._sensor = ObstacleSensor(obs.world, max_points=ctl.max_obstacle_points)
-        # every person as a track; more than the controller holds: the C keeps the nearest
-        tracks = np.hstack([obs.humans_now, obs.humans_velocity])
+        # every person as a track, as the tracker gave it (the C predicts); more than the controller holds:
+        # the C keeps the nearest
         r = ctl.step(obs.time, pose=obs.x[:3], v=float(obs.x[3]), omega=self._omega, path=self._path(obs),
-                     goal=obs.goal[:3], people=tracks, ids=np.arange(tracks.shape[0]),
+                     goal=obs.goal[:3], people=obs.tracks, ids=obs.ids, covariances=obs.human_covariances,
                      obstacles=self._sensor.points(obs.x[:2]))
         self.last = r
         self._omega = float(r.command[1])

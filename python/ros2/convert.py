@@ -13,6 +13,8 @@ from typing import Any
 
 import numpy as np
 
+from ..codegen.ros import NODE_MAX_TRACKS, node_stop_reason
+
 try:  # the ros2 extra
     from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
     from geometry_msgs.msg import PoseStamped, Quaternion
@@ -29,14 +31,15 @@ PEOPLE_OPTIONAL = ("id", "cov_xx", "cov_xy", "cov_yy")  # track id (an integer),
 PEOPLE_FIELDS = PEOPLE_REQUIRED + PEOPLE_OPTIONAL
 _NUMPY_OF = {PointField.INT8: "i1", PointField.UINT8: "u1", PointField.INT16: "i2", PointField.UINT16: "u2",
              PointField.INT32: "i4", PointField.UINT32: "u4", PointField.FLOAT32: "f4", PointField.FLOAT64: "f8"}
-MAX_PEOPLE = 1024  # one message's bound (more is a broken tracker: the node's too_many_tracks)
+STALE_PEOPLE = node_stop_reason("stale_people").name
+MAX_PEOPLE = NODE_MAX_TRACKS  # one message's bound, the ROS 1 node's (more is a broken tracker: too_many_tracks)
 
 
 class MessageError(ValueError):
     """A people message the node cannot use (it names the field and why): no usable people, so the node's
     stop ``reason`` (stale_people, or too_many_tracks)."""
 
-    def __init__(self, message: str, reason: str = "stale_people") -> None:
+    def __init__(self, message: str, reason: str = STALE_PEOPLE) -> None:
         super().__init__(message)
         self.reason = reason
 

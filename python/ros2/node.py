@@ -42,13 +42,20 @@ except ImportError as err:
 
 from .. import load
 from ..codegen.params import PARAMS, Param
-from ..codegen.ros import NodeParam
+from ..codegen.ros import NodeParam, node_stop_reason
 from ..codegen.ros2 import NODE2_PARAMS, NODE2_STOP_REASONS
 from ..controller import Controller
 from ..status import STOP_REASONS
 from . import convert
 
 REASON = {r.name: r for r in NODE2_STOP_REASONS}
+# The node's own stops by their cause, from the one table (codegen.ros.NODE_STOP_REASONS, as the ROS 1 node's):
+# a name it lacks fails at import, not at the first stop.
+STALE = {key: node_stop_reason(name, NODE2_STOP_REASONS).name
+         for key, name in (("odom", "stale_odometry"), ("people", "stale_people"), ("scan", "stale_scan"))}
+FUTURE_STAMP = node_stop_reason("future_stamp", NODE2_STOP_REASONS).name
+NO_TRANSFORM = node_stop_reason("no_transform", NODE2_STOP_REASONS).name
+TOO_MANY_TRACKS = node_stop_reason("too_many_tracks", NODE2_STOP_REASONS).name
 LATCHED = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
 RELIABLE = QoSProfile(depth=5, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
@@ -221,14 +228,14 @@ class ControllerNode(Node):
     def _age_problem(self, key: str, now: float, timeout: float, required: bool) -> tuple[str, str] | None:
         """(reason, detail) when the input ``key`` is stale, missing while required, or from the future."""
         latest = self.inputs[key]
-        stale = {"odom": "stale_odometry", "people": "stale_people", "scan": "stale_scan"}[key]
+        stale = STALE[key]
         if latest.stamp is None:
             return (stale, f"no {key} yet") if required else None
         age = now - latest.stamp
         if latest.stamp == 0.0 or age > timeout:
             return stale, f"{key} stamped {age:.3f} s ago (timeout {timeout:g} s)"
         if -age > float(self.node_params["stamp_tolerance"]):
-            return "future_stamp", f"{key} stamped {-age:.3f} s ahead of the node's clock"
+            return FUTURE_STAMP, f"{key} stamped {-age:.3f} s ahead of the node's clock"
         return None
 
     def _check_inputs(self, now: float) -> tuple[str, str] | None:
@@ -260,7 +267,7 @@ class ControllerNode(Node):
             header.frame_id = odom.header.frame_id
             frames = self._frames(odom)
             if frames is not None:
-                problem = ("no_transform", frames)
+                problem = (NO_TRANSFORM, frames)
         if problem is None:
             try:
                 result = self._step(odom, now)
@@ -310,7 +317,7 @@ class ControllerNode(Node):
             people, ids, cov = convert.people_arrays(self.inputs["people"].msg)
             if len(people) > convert.MAX_PEOPLE:
                 raise convert.MessageError(f"{len(people)} tracks in one message, more than {convert.MAX_PEOPLE}",
-                                           reason="too_many_tracks")
+                                           reason=TOO_MANY_TRACKS)
         obstacles = None
         scan = self.inputs["scan"].msg
         if scan is not None:

@@ -1,13 +1,14 @@
-"""Human motion prediction from observed positions.
+"""People as tracks, and their motion predicted from them.
 
-A :class:`Predictor` is fed the humans' *observed* positions once per control step and returns
-their predicted positions at the MPC's nodes, ``(N + 1, k, 2)`` with node 0 the current
-observation. It never sees the simulator's velocities.
+A :class:`Tracker` is fed the humans' *observed* positions once per control step and returns their
+tracks: the velocity it estimates for each person, ``(k, 2)``, in the order of the observation. It
+never sees the simulator's velocities. The evaluation hands planners tracks (positions, velocities,
+ids), not predicted paths: the MPC planner's controller predicts in C, once; a planner that wants
+predicted paths calls :func:`predict_constant_velocity` (or a :class:`Predictor`) itself.
 
 The people observed may change from one step to the next (recorded crowds: people enter and
 leave the scene). An observation then carries their ids, ``(k,)`` integers that name the same
-person across steps; the prediction is in the order of that observation, and a person's velocity
-comes from that person's own observations only.
+person across steps; a person's velocity comes from that person's own observations only.
 """
 
 from __future__ import annotations
@@ -18,6 +19,19 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 FloatArray = NDArray[np.float64]
+
+
+@runtime_checkable
+class Tracker(Protocol):
+    """Turns a stream of observed positions into the people's velocities."""
+
+    def reset(self) -> None:
+        """Forget every past observation (new episode)."""
+
+    def observe(self, time: float, positions: ArrayLike, ids: ArrayLike | None = None) -> FloatArray:
+        """Record the humans' positions (k, 2) seen at ``time`` (with their ids (k,), if the people
+        present may change) and return their velocities (k, 2) [m/s], in the observation's order."""
+        ...
 
 
 @runtime_checkable
@@ -36,12 +50,23 @@ class Predictor(Protocol):
         ...
 
 
-class ConstantVelocityPredictor:
-    """Constant velocity model (Schöller et al. 2020).
+def predict_constant_velocity(positions: ArrayLike, velocities: ArrayLike, horizon: int, dt: float) -> FloatArray:
+    """Tracks' positions (k, 2) and velocities (k, 2) walked on at constant velocity: their positions at
+    the nodes 0..horizon, ``dt`` apart, (horizon + 1, k, 2) (node 0: the positions)."""
+    now = np.asarray(positions, dtype=float).reshape(-1, 2)
+    vel = np.asarray(velocities, dtype=float).reshape(-1, 2)
+    if vel.shape != now.shape:
+        raise ValueError(f"predict_constant_velocity: {now.shape[0]} positions but {vel.shape[0]} velocities")
+    t = dt * np.arange(horizon + 1)
+    return now[None, :, :] + t[:, None, None] * vel[None, :, :]
+
+
+class ConstantVelocityTracker:
+    """Velocities by finite differences (the constant velocity model, Schöller et al. 2020).
 
     A person's velocity is the finite difference of their last two observations (over the last
     ``window`` intervals if ``window > 1``, or as many as they have); with a single observation
-    a person is predicted to stand still.
+    a person stands still.
 
     Without ids the people are the same ones, in the same order, at every step, and their number
     must not change within an episode. With ids, people may appear and disappear: a person not
@@ -49,11 +74,9 @@ class ConstantVelocityPredictor:
     observation), and a new id starts with one.
     """
 
-    def __init__(self, horizon: int = 50, dt: float = 0.1, window: int = 1) -> None:
-        if horizon < 1 or dt <= 0 or window < 1:
-            raise ValueError("ConstantVelocityPredictor needs horizon >= 1, dt > 0 and window >= 1")
-        self.horizon = horizon
-        self.dt = dt
+    def __init__(self, window: int = 1) -> None:
+        if window < 1:
+            raise ValueError("ConstantVelocityTracker needs window >= 1")
         self.window = window
         self._last_time: float | None = None
         self._count: int | None = None  # people of the id-less stream
@@ -95,7 +118,23 @@ class ConstantVelocityPredictor:
             history[i] = [*past[-(keep - 1):], (float(time), p.copy())]  # keep >= 2
         self._history = history
         self._ids = who
-        return self.predict()
+        return self.velocities()
+
+    @property
+    def observed(self) -> bool:
+        """True once observe() was called (since the last reset)."""
+        return self._last_time is not None
+
+    @property
+    def ids(self) -> NDArray[np.int64]:
+        """The ids of the last observation, in its order."""
+        return self._ids
+
+    def positions(self) -> FloatArray:
+        """The last observed positions (k, 2), in its order."""
+        if self._last_time is None:
+            raise RuntimeError("positions: no observation yet; call observe() first")
+        return np.array([self._history[i][-1][1] for i in self._ids.tolist()]).reshape(-1, 2)
 
     def velocities(self) -> FloatArray:
         """Estimated velocities (k, 2) of the people of the last observation, in its order."""
@@ -107,9 +146,34 @@ class ConstantVelocityPredictor:
                 out[j] = (p_new - p_old) / (t_new - t_old)
         return out
 
+
+class ConstantVelocityPredictor:
+    """Predicted paths for planners that want them: a :class:`ConstantVelocityTracker`'s tracks walked on
+    at constant velocity over ``horizon`` intervals of ``dt`` (:func:`predict_constant_velocity`)."""
+
+    def __init__(self, horizon: int = 50, dt: float = 0.1, window: int = 1) -> None:
+        if horizon < 1 or dt <= 0 or window < 1:
+            raise ValueError("ConstantVelocityPredictor needs horizon >= 1, dt > 0 and window >= 1")
+        self.horizon = horizon
+        self.dt = dt
+        self.tracker = ConstantVelocityTracker(window)
+
+    @property
+    def window(self) -> int:
+        return self.tracker.window
+
+    def reset(self) -> None:
+        self.tracker.reset()
+
+    def observe(self, time: float, positions: ArrayLike, ids: ArrayLike | None = None) -> FloatArray:
+        self.tracker.observe(time, positions, ids)
+        return self.predict()
+
+    def velocities(self) -> FloatArray:
+        """Estimated velocities (k, 2) of the people of the last observation, in its order."""
+        return self.tracker.velocities()
+
     def predict(self) -> FloatArray:
-        if self._last_time is None:
+        if not self.tracker.observed:
             raise RuntimeError("predict: no observation yet; call observe() first")
-        now = np.array([self._history[i][-1][1] for i in self._ids.tolist()]).reshape(-1, 2)
-        t = self.dt * np.arange(self.horizon + 1)
-        return now[None, :, :] + t[:, None, None] * self.velocities()[None, :, :]
+        return predict_constant_velocity(self.tracker.positions(), self.tracker.velocities(), self.horizon, self.dt)

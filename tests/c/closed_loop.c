@@ -137,6 +137,8 @@ int main(int argc, char **argv)
         for (j = 0; j < k; j++) {
             in.humans_now[j][0] = pos[j][0];
             in.humans_now[j][1] = pos[j][1];
+            in.humans_vel[j][0] = vel[j][0];
+            in.humans_vel[j][1] = vel[j][1];
             for (n = 0; n < NNODES; n++) {
                 in.humans_pred[n][j][0] = pos[j][0] + vel[j][0] * DT * n;
                 in.humans_pred[n][j][1] = pos[j][1] + vel[j][1] * DT * n;

@@ -100,7 +100,7 @@ static double take_real(source *s, double lo, double hi)
 }
 
 /* The harness's own reading of the input contract (monitor.h: finite, positions within 1e5 m, angles
- * within 1e4 rad, speeds within 100 m/s; 0 <= n_humans <= N_h; has_obstacle 0 or 1; only present
+ * within 1e4 rad, speeds (the robot's, each component of a person's velocity) within 100 m/s; 0 <= n_humans <= N_h; has_obstacle 0 or 1; only present
  * humans and a present obstacle are read): 1 when the input breaks it. */
 static int finite_within(double v, double limit)
 {
@@ -123,6 +123,8 @@ static int input_bad(void)
         return 1;
     for (j = 0; j < in.n_humans; j++) {
         if (!(finite_within((double)in.humans_now[j][0], 1e5) && finite_within((double)in.humans_now[j][1], 1e5)))
+            return 1;
+        if (!(finite_within((double)in.humans_vel[j][0], 100.0) && finite_within((double)in.humans_vel[j][1], 100.0)))
             return 1;
         for (n = 0; n < NNODES; n++)
             if (!(finite_within((double)in.humans_pred[n][j][0], 1e5) &&
@@ -155,6 +157,8 @@ static void fill_input(source *s)
         const double vx = take_real(s, -1.5, 1.5), vy = take_real(s, -1.5, 1.5);
         in.humans_now[j][0] = hx;
         in.humans_now[j][1] = hy;
+        in.humans_vel[j][0] = vx;
+        in.humans_vel[j][1] = vy;
         for (n = 0; n < NNODES; n++) {
             in.humans_pred[n][j][0] = hx + vx * 0.1 * n;
             in.humans_pred[n][j][1] = hy + vy * 0.1 * n;
