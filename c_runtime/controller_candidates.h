@@ -7,10 +7,18 @@
  * applied, with hysteresis: another plan replaces the passing decision applied last period (that person on
  * that side, or the main plan) only when it costs less by candidate_hysteresis (a fraction). HM_NCAND = 1:
  * the main plan alone, and nothing here runs.
+ *
+ * Memory: the candidates are solved one after the other in the main plan's solver, its warm start kept
+ * aside meanwhile (ocp_nlp_iterate.h) and put back after them, so that its next period runs bit for bit as
+ * it would have; of the candidates' outputs at most three are kept (the cheapest so far, last period's
+ * decision, the one being solved). A candidate beyond the first costs a few bytes, not a solver.
  */
 #ifndef CONTROLLER_CANDIDATES_H
 #define CONTROLLER_CANDIDATES_H
 #include "controller_common.h"
+
+/* Before the first period (controller_init; then controller_candidates_reset). */
+HM_FUNC void controller_candidates_init(hm_controller *c);
 
 /* Forget every candidate's plan and passing decision (a new episode). */
 HM_FUNC void controller_candidates_reset(hm_controller *c);
