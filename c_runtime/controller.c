@@ -80,7 +80,6 @@ HM_FUNC void controller_init(hm_controller *c, const hm_params *params)
     int j;
     c->params = *params;
     ocp_nlp_sqp_init(&c->solver, params);
-    controller_candidates_init(c);
     c->in.n_humans = 0;
     c->in.has_obstacle = 0;
     c->in.has_refs = 0;

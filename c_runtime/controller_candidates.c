@@ -114,14 +114,6 @@ static int candidate_usable(const hm_output *o)
     return !o->stop && o->qp_status == HM_QP_SOLVED;
 }
 
-HM_FUNC void controller_candidates_init(hm_controller *c)
-{
-    int k, i;
-    for (k = 0; k < HM_NCAND - 1; k++)
-        for (i = 0; i < HM_NX; i++) c->candidate_x0_last[k][i] = HM_R(0.0);
-    controller_candidates_reset(c);
-}
-
 HM_FUNC void controller_candidates_reset(hm_controller *c)
 {
     c->chosen_id = -1;
@@ -144,7 +136,7 @@ HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, 
     const hm_real tol = hm_fmax(s->params.qp_tol, HM_R(1e-6));
     int usable[HM_NCAND], id[HM_NCAND], side[HM_NCAND], buffer[HM_NCAND];
     hm_real cost[HM_NCAND];
-    int k, i, best = -1, last = -1, ok = 0, kept = 0;
+    int k, best = -1, last = -1, ok = 0, kept = 0;
     for (k = 0; k < HM_NCAND; k++) {
         const int j = (k - 1) / 2;
         usable[k] = 0;
@@ -164,12 +156,12 @@ HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, 
             buffer[k] = candidate_free_buffer(buffer, best, last);
             /* from its guide in every period: warm from its own last plan, a candidate drifted into the main
              * plan's standstills (walking along beside a crossing person: 16 of 32 crossings missed the goal
-             * in time, none from the guide) */
+             * in time, none from the guide). From the measured state, so the solver's jump test compares it
+             * with this period's (the main plan's): a candidate's own last one, from the last period it ran,
+             * refused it in the first period of an episode and after periods without it. */
             ocp_nlp_sqp_reset(s);
-            for (i = 0; i < HM_NX; i++) s->x0_last[i] = c->candidate_x0_last[k - 1][i];
             candidate_guide(s, in, j, (hm_real)side[k]);
             ocp_nlp_sqp_solve_timed(s, in, &c->candidate_out[buffer[k]], CANDIDATE_SEED_ITERATIONS, tol, t0);
-            for (i = 0; i < HM_NX; i++) c->candidate_x0_last[k - 1][i] = s->x0_last[i];
             usable[k] = candidate_usable(&c->candidate_out[buffer[k]]);
             cost[k] = c->candidate_out[buffer[k]].cost;
         }
@@ -195,11 +187,6 @@ HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, 
 }
 
 #else /* HM_NCAND == 1: the main plan alone */
-
-HM_FUNC void controller_candidates_init(hm_controller *c)
-{
-    controller_candidates_reset(c);
-}
 
 HM_FUNC void controller_candidates_reset(hm_controller *c)
 {

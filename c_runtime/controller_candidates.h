@@ -17,9 +17,6 @@
 #define CONTROLLER_CANDIDATES_H
 #include "controller_common.h"
 
-/* Before the first period (controller_init; then controller_candidates_reset). */
-HM_FUNC void controller_candidates_init(hm_controller *c);
-
 /* Forget every candidate's plan and passing decision (a new episode). */
 HM_FUNC void controller_candidates_reset(hm_controller *c);
 

@@ -34,8 +34,6 @@ typedef struct HM_NS(controller) {
      * plan) and the side. */
 #if HM_NCAND > 1
     HM_NS(ocp_nlp_iterate) main_kept;
-    HM_REAL candidate_x0_last[HM_NCAND - 1][HM_NX];   /* each candidate's measured state when it last ran (its
-                                                         solve's jump test) */
     HM_NS(output) candidate_out[HM_NCAND - 1 < 3 ? HM_NCAND - 1 : 3];
 #endif
     int chosen_id;
