@@ -31,6 +31,6 @@ def test_a_second_plan_costs_the_kept_warm_start_and_one_output_not_a_solver(siz
 
 def test_beyond_three_plans_each_costs_a_few_bytes(sizes: dict[int, int]) -> None:
     """Three output buffers at most (the cheapest plan so far, last period's decision, the one being solved):
-    from the fourth plan on, a candidate adds only its last measured state."""
+    from the fourth plan on, a candidate adds nothing to the controller (a few ints on the step's stack)."""
     assert sizes[4] - sizes[2] <= 8 * 1024, sizes
     assert sizes[8] - sizes[4] <= 4 * 256, sizes
