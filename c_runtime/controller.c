@@ -80,9 +80,6 @@ HM_FUNC void controller_init(hm_controller *c, const hm_params *params)
     int j;
     c->params = *params;
     ocp_nlp_sqp_init(&c->solver, params);
-#if HM_NCAND > 1
-    for (j = 0; j < HM_NCAND - 1; j++) ocp_nlp_sqp_init(&c->candidates[j], params);
-#endif
     c->in.n_humans = 0;
     c->in.has_obstacle = 0;
     c->in.has_refs = 0;

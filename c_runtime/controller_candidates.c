@@ -9,19 +9,26 @@
  */
 #include "controller_candidates.h"
 
+#include "ocp_nlp_iterate.h"
 #include "ocp_nlp_lin.h"
 #include "ocp_nlp_rti.h"
 #include "ocp_nlp_screen.h"
 #include "ocp_nlp_sqp.h"
 #include "ocp_qp.h"
 
+/* A candidate's one SQP iteration (ocp_nlp_sqp_seed_step): its QP's tolerance, at least params.qp_tol (a
+ * plan for this period alone, which the main plan's warm start does not follow; 1e-5 is also single
+ * precision's floor for a damped step); the screening radius of its rows [m] at every node: one QP step
+ * from a guide moves the nodes far less than the robot's reach by node n, the radius of a cold start
+ * (ocp_nlp_screen_reach: 5.5 m at the horizon's end, whose QPs held 217 rows on average at 30 people, the
+ * main plan's 55), and a row the step violates joins the QP all the same. */
+#define CANDIDATE_QP_TOL HM_R(1e-5)
+#define CANDIDATE_SCREEN_RADIUS HM_R(1.5)
 /* The guide's clearance beyond the potential's half-height distance d_th [m], and its pursuit: the turn
  * rate per radian of bearing, the nodes it looks ahead along the route after the person. */
 #define CANDIDATE_CLEARANCE HM_R(0.3)
 #define CANDIDATE_TURN_GAIN HM_R(2.0)
 #define CANDIDATE_LOOKAHEAD 5
-/* SQP iterations from a guide (a guide is no solution: one iteration leaves it far from one). */
-#define CANDIDATE_SEED_ITERATIONS 1
 
 #if HM_NCAND > 1
 
@@ -104,6 +111,7 @@ static void candidate_guide(hm_solver *s, const hm_input *in, int j, hm_real sid
     s->dyn_fresh = 1;
     ocp_qp_sol_set_zero(&s->mult);
     ocp_nlp_screen_reach(s);
+    for (n = 0; n <= HM_N; n++) s->screen_radius[n] = hm_fmin(s->screen_radius[n], CANDIDATE_SCREEN_RADIUS);
     s->warm = 1;
 }
 
@@ -115,56 +123,69 @@ static int candidate_usable(const hm_output *o)
 
 HM_FUNC void controller_candidates_reset(hm_controller *c)
 {
-    int k;
-    for (k = 0; k < HM_NCAND - 1; k++) ocp_nlp_sqp_reset(&c->candidates[k]);
     c->chosen_id = -1;
     c->chosen_side = 0;
 }
 
+/* An output buffer that holds neither the cheapest usable plan so far nor the last decision's (their
+ * candidate indices best and last, 0 or -1 for none in a buffer): of three, one is always free. */
+static int candidate_free_buffer(const int *buffer, int best, int last)
+{
+    int b;
+    for (b = 0;; b++)
+        if (!(best > 0 && buffer[best] == b) && !(last > 0 && buffer[last] == b)) return b;
+}
+
 HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, hm_controller_output *out)
 {
+    hm_solver *s = &c->solver;
     const hm_input *in = &c->in;
-    const hm_real tol = hm_fmax(c->solver.params.qp_tol, HM_R(1e-6));
-    int usable[HM_NCAND], id[HM_NCAND], side[HM_NCAND];
+    int usable[HM_NCAND], id[HM_NCAND], side[HM_NCAND], buffer[HM_NCAND];
     hm_real cost[HM_NCAND];
-    int k, best = -1, last = -1, ok = 0;
-    usable[0] = candidate_usable(&c->out);
-    cost[0] = c->out.cost;
-    id[0] = -1;
-    side[0] = 0;
-    for (k = 1; k < HM_NCAND; k++) {
-        hm_solver *s = &c->candidates[k - 1];
-        hm_output *o = &c->candidate_out[k - 1];
+    int k, best = -1, last = -1, ok = 0, kept = 0;
+    for (k = 0; k < HM_NCAND; k++) {
         const int j = (k - 1) / 2;
         usable[k] = 0;
         cost[k] = HM_INF;
-        side[k] = (k - 1) % 2 == 0 ? 1 : -1;
-        id[k] = j < in->n_humans ? out->people_ids[j] : -1;
-        if (j >= in->n_humans || !c->params.passing) continue;
-        s->params = c->solver.params;
-        s->clock = c->solver.clock;
-        s->clock_ctx = c->solver.clock_ctx;
-        /* from its guide in every period: warm from its own last plan, a candidate drifted into the main
-         * plan's standstills (walking along beside a crossing person: 16 of 32 crossings missed the goal
-         * in time, none from the guide) */
-        ocp_nlp_sqp_reset(s);
-        candidate_guide(s, in, j, (hm_real)side[k]);
-        ocp_nlp_sqp_solve_timed(s, in, o, CANDIDATE_SEED_ITERATIONS, tol, t0);
-        usable[k] = candidate_usable(o);
-        cost[k] = o->cost;
-    }
-    for (k = 0; k < HM_NCAND; k++) {
+        buffer[k] = -1;
+        side[k] = k == 0 ? 0 : (k - 1) % 2 == 0 ? 1 : -1;
+        id[k] = k == 0 ? -1 : j < in->n_humans ? out->people_ids[j] : -1;
+        if (k == 0) {
+            usable[0] = candidate_usable(&c->out);
+            cost[0] = c->out.cost;
+        } else if (j < in->n_humans && c->params.passing) {
+            if (!kept) {
+                /* the main plan's warm start, for its next period: the candidates use its solver */
+                ocp_nlp_iterate_save(s, &c->main_kept);
+                kept = 1;
+            }
+            buffer[k] = candidate_free_buffer(buffer, best, last);
+            /* from its guide in every period: warm from its own last plan, a candidate drifted into the main
+             * plan's standstills (walking along beside a crossing person: 16 of 32 crossings missed the goal
+             * in time, none from the guide). From the measured state, so the solver's jump test compares it
+             * with this period's (the main plan's): a candidate's own last one, from the last period it ran,
+             * refused it in the first period of an episode and after periods without it. */
+            ocp_nlp_sqp_reset(s);
+            candidate_guide(s, in, j, (hm_real)side[k]);
+            ocp_nlp_sqp_seed_step(s, in, &c->candidate_out[buffer[k]], hm_fmax(s->params.qp_tol, CANDIDATE_QP_TOL),
+                                  t0);
+            usable[k] = candidate_usable(&c->candidate_out[buffer[k]]);
+            cost[k] = c->candidate_out[buffer[k]].cost;
+        }
+        /* in the order of the indices, as over all of them at the end: the first of the lowest cost, the
+         * last of the decision applied last period */
         ok += usable[k];
         if (usable[k] && (best < 0 || cost[k] < cost[best])) best = k;
         if (usable[k] && id[k] == c->chosen_id && side[k] == c->chosen_side) last = k;
     }
+    if (kept) ocp_nlp_iterate_restore(s, &c->main_kept);
     /* hysteresis: the passing decision applied last period (the same person on the same side, or the main
      * plan) stays unless another plan costs less by the fraction */
     if (best >= 0 && last >= 0 && last != best &&
         !(cost[best] < (HM_R(1.0) - c->params.candidate_hysteresis) * cost[last]))
         best = last;
     if (best < 0) best = 0;   /* none usable: the main plan's stop stands */
-    if (best > 0) c->out = c->candidate_out[best - 1];
+    if (best > 0) c->out = c->candidate_out[buffer[best]];
     c->chosen_id = id[best];
     c->chosen_side = side[best];
     out->candidate = best;

@@ -27,11 +27,14 @@ typedef struct HM_NS(controller) {
     int has_origin;
     HM_REAL origin[2];
     HM_REAL origin_goal[2];
-    /* Passing decisions (controller_candidates.h): the other candidate plans, each with its own solver and
-     * output; the decision applied last period: the track id passed (-1: the main plan) and the side. */
+    /* Passing decisions (controller_candidates.h): the other candidate plans are solved one after the other
+     * in the solver's own memory, its warm start kept aside meanwhile (main_kept); of their outputs only
+     * those that may still be applied are kept (the cheapest so far, the decision of last period, and the one
+     * being solved: at most three). The decision applied last period: the track id passed (-1: the main
+     * plan) and the side. */
 #if HM_NCAND > 1
-    HM_NS(solver) candidates[HM_NCAND - 1];
-    HM_NS(output) candidate_out[HM_NCAND - 1];
+    HM_NS(ocp_nlp_iterate) main_kept;
+    HM_NS(output) candidate_out[HM_NCAND - 1 < 3 ? HM_NCAND - 1 : 3];
 #endif
     int chosen_id;
     int chosen_side;

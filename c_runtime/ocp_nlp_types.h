@@ -61,3 +61,19 @@ typedef struct HM_NS(solver) {
     /* 1: the clock ran backwards during this step (ocp_nlp_deadline_passed): a clock fault. */
     int clock_fault;
 } HM_NS(solver);
+
+/* What of a solver its next step reads, kept aside while other solves use its memory (ocp_nlp_iterate.h:
+ * which fields and why these). */
+typedef struct HM_NS(ocp_nlp_iterate) {
+    HM_REAL x[HM_N + 1][HM_NX];
+    HM_REAL u[HM_N][HM_NU];
+    HM_REAL pi[HM_N][HM_NX];
+    HM_REAL lam_lg[HM_N + 1][HM_NG];
+    HM_REAL screen_radius[HM_N + 1];
+    HM_REAL x0_last[HM_NX];
+    HM_REAL cost, cost_slack, merit_mu, time_prepare_ms;
+    HM_NS(ocp_qp_ipm_arg) ipm_arg;
+    unsigned long long t_start, deadline_ns;
+    int warm, prepared, n_active, dyn_fresh, qp_solves, qp_rows_max, qp_rows_capped, qp_budget, clock_fault;
+    int qp_warm_ready;   /* ipm_ws.warm.ready */
+} HM_NS(ocp_nlp_iterate);

@@ -49,6 +49,7 @@ RUNTIME_SOURCES = (
     "ocp_nlp_out.c",
     "ocp_nlp_rti.c",
     "ocp_nlp_sqp.c",
+    "ocp_nlp_iterate.c",
     "controller_common.c",
     "controller_path.c",
     "controller_people.c",

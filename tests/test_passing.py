@@ -135,3 +135,16 @@ def test_without_passing_decisions_a_three_plan_package_commands_what_a_one_plan
         chose_other += r.candidate != 0
         x = step(model, x, r.u, DT)
     assert chose_other > 0
+
+
+def test_the_candidates_run_in_the_first_period_of_an_episode_that_starts_elsewhere(passing_dir: Path) -> None:
+    """A candidate starts from its guide at the measured state: nothing for the solver's state-jump test to
+    refuse. (Tested against the state of the last period the candidate ran, it refused every candidate in the
+    first period after a reset at another place.)"""
+    c = humanmpc.load(passing_dir).controller()
+    person = np.array([[4.0, 0.0, 0.0, 0.0]])
+    first = c.step(0.0, pose=np.zeros(3), v=0.0, goal=GOAL, people=person)
+    c.reset()
+    again = c.step(0.0, pose=np.array([20.0, 5.0, 0.0]), v=0.0, goal=(30.0, 5.0, 0.0),
+                   people=person + np.array([20.0, 5.0, 0.0, 0.0]))
+    assert first.candidates_ok == again.candidates_ok == 3, (first.candidates_ok, again.candidates_ok)

@@ -407,6 +407,7 @@ class ControllerLine:
     distance_to_goal: float
     time_total_ms: float  # the controller's own clock: QEMU's virtual time
     ticks: int  # SysTick ticks of the step, measured around it
+    candidate: int  # the plan applied: 0 the main one, k the k-th candidate
 
     @property
     def instructions(self) -> int:
@@ -415,7 +416,7 @@ class ControllerLine:
     @property
     def decision(self) -> tuple[int, ...]:
         return (self.outcome, self.stop, self.stop_reason, self.status, self.qp_status, self.goal_reached,
-                self.stalled, self.recovered, self.loop_detected)
+                self.stalled, self.recovered, self.loop_detected, self.candidate)
 
 
 @dataclass
@@ -463,7 +464,7 @@ def parse_controller_output(text: str) -> ControllerRun:
         run.steps.append(ControllerLine(
             i[0], i[1], i[2], i[3], i[4], i[5], i[6], i[7], i[8], i[9], i[10], i[11], people,
             (reals[0], reals[1]), (reals[2], reals[3]), (reals[4], reals[5], reals[6], reals[7]),
-            (reals[8], reals[9]), reals[10], reals[11], int(f[26 + n_people])))
+            (reals[8], reals[9]), reals[10], reals[11], int(f[26 + n_people]), int(f[27 + n_people])))
     if len(run.steps) != int(n_steps):
         raise FirmwareError(f"the controller firmware reported {len(run.steps)} periods of {n_steps}")
     run.probe_stop_reason = int(probe[0][1])
@@ -477,7 +478,7 @@ def parse_controller_output(text: str) -> ControllerRun:
 
 def host_decision(r: ControllerResult) -> tuple[int, ...]:
     return (r.outcome, int(r.stop), r.stop_reason, r.status, r.qp_status, int(r.goal_reached), int(r.stalled),
-            int(r.recovered), int(r.loop_detected))
+            int(r.recovered), int(r.loop_detected), r.candidate)
 
 
 @dataclass(frozen=True)
@@ -493,7 +494,7 @@ class ControllerAgreement:
     max_rel: float  # max over periods of the relative difference
     max_rel_same: float  # ... over the periods whose decisions agree
     median_rel: float
-    mismatched_periods: tuple[int, ...]  # periods whose decisions (outcome, stop and reason, statuses, flags) differ
+    mismatched_periods: tuple[int, ...]  # periods whose decisions (outcome, stop, statuses, flags, plan) differ
     people_mismatches: int  # periods whose chosen people differ
     first_mismatch: str
 
@@ -530,7 +531,7 @@ def compare_controller(run: ControllerRun, host: Sequence[ControllerResult], par
     if mismatched:
         s, h = run.steps[mismatched[0]], host[mismatched[0]]
         first = (f"period {s.t}: firmware (outcome, stop, reason, status, qp_status, goal_reached, stalled, "
-                 f"recovered, loop_detected) = {s.decision}, host {host_decision(h)}")
+                 f"recovered, loop_detected, candidate) = {s.decision}, host {host_decision(h)}")
     same = [r for r, s in zip(rel, run.steps, strict=True) if s.t not in mismatched]
     people = sum(s.people_index != tuple(int(i) for i in h.people_index) for s, h in pairs)
     return ControllerAgreement(len(host), dc, du, float(rel.max(initial=0.0)), float(max(same, default=0.0)),
