@@ -16,19 +16,13 @@
 #include "ocp_nlp_sqp.h"
 #include "ocp_qp.h"
 
-/* A candidate's one SQP iteration (ocp_nlp_sqp_seed_step): its QP's tolerance, at least params.qp_tol (a
- * plan for this period alone, which the main plan's warm start does not follow; 1e-5 is also single
- * precision's floor for a damped step); the screening radius of its rows [m] at every node: one QP step
- * from a guide moves the nodes far less than the robot's reach by node n, the radius of a cold start
- * (ocp_nlp_screen_reach: 5.5 m at the horizon's end, whose QPs held 217 rows on average at 30 people, the
- * main plan's 55), and a row the step violates joins the QP all the same. */
-#define CANDIDATE_QP_TOL HM_R(1e-5)
-#define CANDIDATE_SCREEN_RADIUS HM_R(1.5)
 /* The guide's clearance beyond the potential's half-height distance d_th [m], and its pursuit: the turn
  * rate per radian of bearing, the nodes it looks ahead along the route after the person. */
 #define CANDIDATE_CLEARANCE HM_R(0.3)
 #define CANDIDATE_TURN_GAIN HM_R(2.0)
 #define CANDIDATE_LOOKAHEAD 5
+/* SQP iterations from a guide (a guide is no solution: one iteration leaves it far from one). */
+#define CANDIDATE_SEED_ITERATIONS 1
 
 #if HM_NCAND > 1
 
@@ -111,7 +105,6 @@ static void candidate_guide(hm_solver *s, const hm_input *in, int j, hm_real sid
     s->dyn_fresh = 1;
     ocp_qp_sol_set_zero(&s->mult);
     ocp_nlp_screen_reach(s);
-    for (n = 0; n <= HM_N; n++) s->screen_radius[n] = hm_fmin(s->screen_radius[n], CANDIDATE_SCREEN_RADIUS);
     s->warm = 1;
 }
 
@@ -140,6 +133,7 @@ HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, 
 {
     hm_solver *s = &c->solver;
     const hm_input *in = &c->in;
+    const hm_real tol = hm_fmax(s->params.qp_tol, HM_R(1e-6));
     int usable[HM_NCAND], id[HM_NCAND], side[HM_NCAND], buffer[HM_NCAND];
     hm_real cost[HM_NCAND];
     int k, best = -1, last = -1, ok = 0, kept = 0;
@@ -167,8 +161,7 @@ HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, 
              * refused it in the first period of an episode and after periods without it. */
             ocp_nlp_sqp_reset(s);
             candidate_guide(s, in, j, (hm_real)side[k]);
-            ocp_nlp_sqp_seed_step(s, in, &c->candidate_out[buffer[k]], hm_fmax(s->params.qp_tol, CANDIDATE_QP_TOL),
-                                  t0);
+            ocp_nlp_sqp_solve_timed(s, in, &c->candidate_out[buffer[k]], CANDIDATE_SEED_ITERATIONS, tol, t0);
             usable[k] = candidate_usable(&c->candidate_out[buffer[k]]);
             cost[k] = c->candidate_out[buffer[k]].cost;
         }

@@ -10,8 +10,8 @@
  * options and the small counters and times. Not kept: the QP data, the interior-point workspace and the
  * line search's base point, which every step sets up before reading. The QP's kept iterate itself
  * (ipm_ws.warm but for its flag) is not copied: only a solve with warm_mu > 0 writes it, which the
- * real-time iteration is and the full SQP (ocp_nlp_sqp_solve*, ocp_nlp_sqp_seed_step) is not; the solves
- * in between must be of the latter kind.
+ * real-time iteration is and the full SQP (ocp_nlp_sqp_solve*) is not; the solves in between must be of
+ * the latter kind.
  */
 #ifndef OCP_NLP_ITERATE_H
 #define OCP_NLP_ITERATE_H

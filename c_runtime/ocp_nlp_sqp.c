@@ -6,7 +6,6 @@
  */
 #include "ocp_nlp_sqp.h"
 
-#include "ocp_nlp_cost.h"
 #include "ocp_nlp_lin.h"
 #include "ocp_nlp_out.h"
 #include "ocp_nlp_step.h"
@@ -58,20 +57,14 @@ HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
      * the controller's nudged recovery does, compares with it) */
 }
 
-/* How the SQP is run: as the reference (tests, recoveries), or as a seed step (one iteration for one of
- * several plans of a control period: ocp_nlp_sqp_seed_step). */
-enum ocp_nlp_sqp_mode { OCP_NLP_SQP_REFERENCE, OCP_NLP_SQP_SEED };
-
 /* Under the same monitors as the real-time iteration: the inputs and parameters before, the deadline of
  * params.deadline_ms from t0 (polled inside the QPs and between the iterations), every QP solved (one
  * stopped at its iteration limit, infeasible or failed ends the SQP, its iterate not applied), the
  * clock, C1 / C2 on the plan and the command guard; each failure a protective stop. max_iter < 1 or a
- * tolerance that is not a positive finite number is an invalid input: nothing is solved. A seed step
- * (ocp_nlp_sqp.h) differs where marked. */
+ * tolerance that is not a positive finite number is an invalid input: nothing is solved. */
 static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
-                               unsigned long long t0, enum ocp_nlp_sqp_mode mode)
+                               unsigned long long t0)
 {
-    const int reference = mode == OCP_NLP_SQP_REFERENCE;
     int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER, reason, late = 0;
     ocp_nlp_clear_output(out);
     ocp_nlp_step_counts_reset(s);
@@ -95,7 +88,7 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
      * the residuals far below the QP tolerance, which is relative to the scaled data; with the
      * recurrence they end just below it, and at tol = 1e-9 the SQP stalled on that (stationarity
      * 3.5e-7 after 300 iterations, 30 people). */
-    s->ipm_arg.recurrence = !reference;   /* a seed step's QP: with the recurrence, as the RTI's */
+    s->ipm_arg.recurrence = 0;
     /* and all of them from the cold start (keeping none, so the next RTI step starts cold too) */
     s->ipm_arg.warm_mu = HM_R(0.0);
     ocp_nlp_start_clock(s, t0);
@@ -108,14 +101,12 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
         }
         ocp_nlp_linearize(s, in, k > 0);
         ocp_nlp_set_x0(s, in);
-        if (reference) ocp_nlp_residuals(s, out);   /* a seed step's one iteration tests none */
+        ocp_nlp_residuals(s, out);
         if (k > 0 && out->kkt_stat <= tol && out->kkt_eq <= tol && out->kkt_ineq <= tol && out->kkt_comp <= tol) {
             status = HM_STATUS_OK;
             break;
         }
-        /* a seed step's as the real-time iteration's: damped when it is (params.line_search) */
-        qp_status = reference || s->params.line_search ? ocp_nlp_qp_line_search_step(s, in, tol, 0, &out->qp_iterations)
-                                                       : ocp_nlp_qp_step(s, in, 0, &out->qp_iterations);
+        qp_status = ocp_nlp_qp_line_search_step(s, in, tol, 0, &out->qp_iterations);
         if (qp_status != HM_QP_SOLVED) { /* the iteration limit too: not a solution */
             status = HM_STATUS_QP_FAILED;
             late = qp_status == HM_QP_TIMEOUT;
@@ -124,17 +115,13 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
     }
     s->ipm_arg.should_stop = 0;
     s->ipm_arg.stop_ctx = 0;
-    if (k == max_iter && reference) {
+    if (k == max_iter) {
         /* Report the residuals at the final iterate. */
         ocp_nlp_linearize(s, in, 1);
         ocp_nlp_set_x0(s, in);
         ocp_nlp_residuals(s, out);
         if (out->kkt_stat <= tol && out->kkt_eq <= tol && out->kkt_ineq <= tol && out->kkt_comp <= tol)
             status = HM_STATUS_OK;
-    } else if (k == max_iter) {
-        /* a seed step: the cost at the final iterate, which the plans are compared by (its residuals,
-         * which need a linearisation there, nobody reads) */
-        s->cost = ocp_nlp_objective(s, in);
     }
     s->ipm_arg.recurrence = 1;
     s->ipm_arg.warm_mu = OCP_NLP_WARM_MU;
@@ -161,26 +148,13 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
 
 HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol)
 {
-    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, ocp_nlp_now(s), OCP_NLP_SQP_REFERENCE);
+    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, ocp_nlp_now(s));
 }
 
 HM_FUNC int ocp_nlp_sqp_solve_timed(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
                                     unsigned long long t0)
 {
-    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, t0, OCP_NLP_SQP_REFERENCE);
-}
-
-HM_FUNC int ocp_nlp_sqp_seed_step(hm_solver *s, const hm_input *in, hm_output *out, hm_real qp_tol,
-                                  unsigned long long t0)
-{
-    /* the QP of the step is solved to params.qp_tol (the line search's to min(params.qp_tol, 0.1 tol)): to
-     * qp_tol here, the caller's parameters unchanged after */
-    const hm_real kept = s->params.qp_tol;
-    int status;
-    s->params.qp_tol = qp_tol;
-    status = ocp_nlp_sqp_iterate(s, in, out, 1, HM_R(10.0) * qp_tol, t0, OCP_NLP_SQP_SEED);
-    s->params.qp_tol = kept;
-    return status;
+    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, t0);
 }
 
 HM_FUNC const char *ocp_nlp_status_message(int status)

@@ -16,14 +16,6 @@ HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, 
 /* The same with the deadline counted from the clock reading t0 (a recovery inside a control period). */
 HM_FUNC int ocp_nlp_sqp_solve_timed(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
                                     unsigned long long t0);
-/* One SQP iteration from the solver's guess (made warm by the caller: a candidate plan's guide), for one
- * of several plans of a control period, under the same monitors and deadline (from t0), made as cheap as
- * the real-time iteration's step: its QP solved to qp_tol with the interior-point recurrence (the
- * reference's exact residuals in every iteration and tenfold tolerance are for references), the full step
- * or, with params.line_search, the damped one; out->cost the objective at the new iterate, no residuals
- * (the reference's linearisation there would be for them alone). Keeps no QP iterate for a next step
- * (warm_mu 0: ocp_nlp_iterate.h). */
-HM_FUNC int ocp_nlp_sqp_seed_step(hm_solver *s, const hm_input *in, hm_output *out, hm_real tol, unsigned long long t0);
 HM_FUNC const char *ocp_nlp_status_message(int status);
 
 #endif /* OCP_NLP_SQP_H */
