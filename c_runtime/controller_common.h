@@ -34,5 +34,7 @@ typedef struct hm_controller_goal {
 
 /* angle + 2 pi k nearest to reference */
 HM_FUNC hm_real controller_unwrap(hm_real angle, hm_real reference);
+/* The bearing of the OCP's goal (the carrot, in->goal) from a robot at x, in (-pi, pi]. */
+HM_FUNC hm_real controller_carrot_bearing(const hm_input *in, const hm_real *x);
 
 #endif /* CONTROLLER_COMMON_H */

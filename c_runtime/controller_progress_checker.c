@@ -48,7 +48,7 @@ HM_FUNC int controller_stalled_command(hm_controller *c)
     hm_solver *s = &c->solver;
     const hm_input *in = &c->in;
     const hm_real v = c->out.command[0];
-    const hm_real towards = hm_cos(hm_atan2(in->goal[1] - in->x0[1], in->goal[0] - in->x0[0]) - in->x0[2]);
+    const hm_real towards = hm_cos(controller_carrot_bearing(in, in->x0));
     const int warm = s->warm;
     if (c->out.stop || !(hm_fabs(v) > CONTROLLER_AT_REST) || v * towards > HM_R(0.0)) return 0;
     ocp_nlp_protective_stop(s, in, &c->out, HM_STOP_NONE);

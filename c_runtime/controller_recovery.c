@@ -95,13 +95,6 @@ static void controller_nudge(hm_controller *c)
     controller_start_from_guess(s);
 }
 
-/* The bearing of the carrot from a robot at x, in (-pi, pi]. */
-static hm_real controller_carrot_bearing(const hm_input *in, const hm_real *x)
-{
-    const hm_real e = hm_atan2(in->goal[1] - x[1], in->goal[0] - x[0]) - x[2];
-    return hm_atan2(hm_sin(e), hm_cos(e));
-}
-
 /* 1 when the carrot is behind the robot (more than 90 degrees off its heading) and the plan stands (its
  * path shorter than stall_distance): the standstill where the OCP is stuck with a goal behind. At rest,
  * turning in place moves no node, so the position terms give the turn no gradient, and v >= 0 forbids
