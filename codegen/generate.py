@@ -104,6 +104,14 @@ def _os_error(dest: Path, err: OSError) -> GenerateError:
     return GenerateError(f"cannot write {dest}: {err.strerror or err}{where}; nothing was written")
 
 
+def write_files(folder: Path, files: dict[str, str]) -> None:
+    """Each text of ``files`` at its path relative to ``folder``, with the folders it needs."""
+    for rel, text in files.items():
+        path = folder / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+
+
 def write_atomically(dest: Path, populate: Callable[[Path], object], force: bool, marker: str = MANIFEST) -> None:
     """Build the folder in a temporary sibling with populate(tmp), then move it to dest.
 

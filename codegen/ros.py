@@ -23,7 +23,7 @@ from typing import Any
 
 from . import __version__
 from .build import BuildError, read_manifest
-from .generate import GenerateError, write_atomically
+from .generate import GenerateError, write_atomically, write_files
 from .params import PARAMS, Range, spec_params
 from .render import _c_string, c_float, c_identifier, make_environment
 from .spec import Spec, SpecError, load_spec
@@ -261,10 +261,7 @@ def solver_spec(solver_dir: Path) -> Spec:
 
 def _populate(solver_dir: Path, spec: Spec, out: Path) -> None:
     context = ros_context(spec)
-    for rel, text in render_ros(context).items():
-        path = out / rel
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text)
+    write_files(out, render_ros(context))
     shutil.copytree(solver_dir, out / context["package"] / "solver",
                     ignore=lambda d, names: [n for n in names if Path(d) == solver_dir and n in _BUILD_DIRS])
     (out / ROS_MARKER).write_text(json.dumps({

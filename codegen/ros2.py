@@ -24,7 +24,7 @@ from typing import Any
 
 from . import __version__
 from .build import is_stale, library_path
-from .generate import GenerateError, write_atomically
+from .generate import GenerateError, write_atomically, write_files
 from .params import PARAMS, Range, spec_params
 from .render import c_identifier, make_environment
 from .ros import NODE_PARAMS, NODE_STOP_REASONS, NodeParam, NodeStopReason, solver_spec, yaml_float
@@ -100,10 +100,7 @@ def render_ros2(context: dict[str, Any]) -> dict[str, str]:
 
 def _populate(solver_dir: Path, spec: Spec, out: Path) -> None:
     context = ros2_context(spec)
-    for rel, text in render_ros2(context).items():
-        path = out / rel
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text)
+    write_files(out, render_ros2(context))
     (out / f"{context['name']}_node.py").chmod(0o755)
     shutil.copytree(solver_dir, out / "solver", symlinks=True)
     (out / ROS2_MARKER).write_text(json.dumps({
