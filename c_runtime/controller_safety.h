@@ -10,6 +10,11 @@
  *                         (HM_STOP_HUMAN_TOO_CLOSE), at the goal, without a goal, turning, stalled;
  *   separation            a plan that moves (not a braking one) commands a speed above the
  *                         speed-and-separation bound of any track: HM_STOP_SEPARATION;
+ *   a stop in time        a plan that moves, followed for the reaction time and then braked along its
+ *                         heading, would still be moving when it comes within d_h of a person's predicted
+ *                         position (the N_h people the OCP sees, from any side: the bound above sees people
+ *                         ahead only): HM_STOP_PREDICTED_CONTACT, while a stop can still bring the robot to
+ *                         rest before they arrive;
  *   the command guard     the command and u0 finite and within the period's bounds (monitor_command_ok):
  *                         else HM_STOP_COMMAND_BOUNDS (braking at the goal from above the speed limit too);
  *   the deadline          the whole period, from its first clock reading, within params.deadline_ms:

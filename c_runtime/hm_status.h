@@ -41,7 +41,8 @@
     X(STOP_SEPARATION, 8, separation, "protective stop (speed and separation): at the commanded speed, braking after the reaction time would not stop the robot before a person closing in comes within d_h") \
     X(STOP_COMMAND_BOUNDS, 9, command_bounds, "protective stop (command guard): the command was not finite or left the bounds of v, omega or a") \
     X(STOP_CLOCK, 10, clock, "protective stop (clock fault): the clock ran backwards or did not advance over a step, so no deadline could be kept") \
-    X(STOP_STATE_JUMP, 11, state_jump, "protective stop: the measured state jumped further since the last step than the bounds allow")
+    X(STOP_STATE_JUMP, 11, state_jump, "protective stop: the measured state jumped further since the last step than the bounds allow") \
+    X(STOP_PREDICTED_CONTACT, 12, predicted_contact, "protective stop (speed and separation): following the plan for the reaction time and then braking, the robot would still be moving when it comes within d_h of a person's predicted position")
 
 /* What a controller step ended with (controller.c): what the robot is doing, in one word. */
 #define HM_OUTCOME_TABLE(X) \

@@ -142,7 +142,9 @@ HM_FUNC void ocp_nlp_protective_stop(hm_solver *s, const hm_input *in, hm_output
     out->command[0] = v_ok && out->x[1][3] * out->x[0][3] > HM_R(0.0) ? out->x[1][3] : HM_R(0.0);
     out->command[1] = HM_R(0.0);
     s->prepared = 0;
-    if (reason != HM_STOP_UNSAFE_PLAN && reason != HM_STOP_HUMAN_TOO_CLOSE && reason != HM_STOP_SEPARATION)
+    /* the safety decisions about people leave a sound plan to start from; the failures do not */
+    if (reason != HM_STOP_UNSAFE_PLAN && reason != HM_STOP_HUMAN_TOO_CLOSE && reason != HM_STOP_SEPARATION &&
+        reason != HM_STOP_PREDICTED_CONTACT)
         s->warm = 0;
 }
 

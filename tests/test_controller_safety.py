@@ -16,6 +16,7 @@ import pytest
 
 import humanmpc
 from humanmpc.controller import Controller
+from humanmpc.sim.robot import RobotModel, step
 from tests.conftest import make_solver
 
 DT = 0.1
@@ -84,6 +85,28 @@ def test_a_person_within_d_h_beside_or_behind_stops_the_robot_among_many_tracks(
     cov = np.array([[4, 0, 4]] * 10 + [[0.01, 0, 0.01]], dtype=float)
     r = ctl.step(0.0, pose=(0, 0, 0), v=0.0, goal=(5, 0, 0), people=people, covariances=cov)
     assert r.stop and r.reason == "human_too_close" and r.command.tolist() == [0.0, 0.0]
+
+
+@pytest.mark.parametrize("speed", [2.0, 2.4])
+def test_a_person_overtaking_from_behind_comes_to_a_robot_at_rest(ctl: Controller, speed: float) -> None:
+    """A person 3 m behind on the robot's line runs after it at 2.5-3 times its speed (tracked for 1.5 s or more
+    before they arrive, longer than the reaction and braking time, 0.3 + 0.8 s). The speed-and-separation
+    bound sees people ahead only: the robot braked only once they were within d_h, at 0.4 m/s. Now it stops
+    while a stop can still bring it to rest before they come within d_h."""
+    sim = RobotModel()
+    x = np.array([0.0, 0.0, 0.0, 0.8])
+    person = np.array([-3.0, 0.0, speed, 0.0])
+    reasons = set()
+    for k in range(60):
+        now = person.copy()
+        now[:2] += k * DT * person[2:]
+        r = ctl.step(k * DT, pose=x[:3], v=x[3], goal=(10.0, 0.0, 0.0), people=now[None, :])
+        if r.stop:
+            reasons.add(r.reason)
+        if nearest(x, now[None, :]) < D_H:
+            assert abs(x[3]) < 0.05, f"moving at {x[3]:.2f} m/s {nearest(x, now[None, :]):.2f} m from them"
+        x = step(sim, x, r.u, DT)
+    assert "predicted_contact" in reasons
 
 
 def test_the_ocp_sees_everyone_within_the_stopping_reach_whatever_their_rank(paper_preset_dir: Path) -> None:

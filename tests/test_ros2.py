@@ -109,7 +109,8 @@ def test_person_within_d_h_gives_a_latched_protective_stop_and_a_braking_command
     t_in = closed_loop["intruder_time"]
     assert t_in is not None
     stops = [(t, reason) for t, stop, reason in closed_loop["stops"] if stop and t_in <= t <= t_in + 1.0]
-    assert stops and stops[0][1] in ("human_too_close", "unsafe_plan", "separation"), closed_loop["stops"]
+    people_stops = ("human_too_close", "unsafe_plan", "separation", "predicted_contact")
+    assert stops and stops[0][1] in people_stops, closed_loop["stops"]
     t_stop = stops[0][0]
     t_end = min([t for t, stop, _ in closed_loop["stops"] if not stop and t > t_stop] + [t_in + 1.0])
     after = [v for t, v, _ in closed_loop["cmds"] if t_stop <= t < t_end]

@@ -370,7 +370,8 @@ class ClosedLoop(unittest.TestCase):
         assert intrusion_stamp is not None
         human = [s for s in stops if s[1] and s[0] >= intrusion_stamp - 1e-6]
         self.assertTrue(human, "no protective stop after the person stepped within d_h")
-        self.assertIn(human[0][2], ("human_too_close", "unsafe_plan", "separation"),
+        self.assertIn(human[0][2], ("human_too_close", "unsafe_plan", "separation",
+                                    "predicted_contact"),
                       f"first stop after the intrusion: {human[0]}")
         latency = human[0][0] - intrusion_stamp
         summary["human_stop_latency_s"] = latency
