@@ -43,6 +43,17 @@ HM_FUNC int controller_progress(hm_controller *c, const hm_controller_input *cin
     return out->time_without_progress > p->stall_time;
 }
 
+/* 1 when the plan o is nearer the carrot half a horizon on than the robot is now: a plan that starts off
+ * sideways or away to go round someone (standing people round a robot facing 94 degrees off its carrot:
+ * every period's plan set off eastwards to turn north, and braking it held the robot for 23 s). Not its
+ * end: walking along beside a crossing person, the plans put the turn back off to their last nodes. */
+static int controller_plan_heads_nearer(const hm_input *in, const hm_output *o)
+{
+    const hm_real ex = in->goal[0] - o->x[HM_N / 2][0], ey = in->goal[1] - o->x[HM_N / 2][1];
+    const hm_real rx = in->goal[0] - in->x0[0], ry = in->goal[1] - in->x0[1];
+    return ex * ex + ey * ey < rx * rx + ry * ry;
+}
+
 HM_FUNC int controller_stalled_command(hm_controller *c)
 {
     hm_solver *s = &c->solver;
@@ -50,7 +61,9 @@ HM_FUNC int controller_stalled_command(hm_controller *c)
     const hm_real v = c->out.command[0];
     const hm_real towards = hm_cos(controller_carrot_bearing(in, in->x0));
     const int warm = s->warm;
-    if (c->out.stop || !(hm_fabs(v) > CONTROLLER_AT_REST) || v * towards > HM_R(0.0)) return 0;
+    if (c->out.stop || !(hm_fabs(v) > CONTROLLER_AT_REST) || v * towards > HM_R(0.0) ||
+        controller_plan_heads_nearer(in, &c->out))
+        return 0;
     ocp_nlp_protective_stop(s, in, &c->out, HM_STOP_NONE);
     c->out.stop = 0;
     /* the solver keeps its plan: a cold start from the braking state finds the same standstill (measured:

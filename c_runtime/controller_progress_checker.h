@@ -11,10 +11,11 @@
  * stall_time. stopped: a protective stop this period (restarts the measure). */
 HM_FUNC int controller_progress(hm_controller *c, const hm_controller_input *cin, const hm_controller_goal *g,
                                 int stopped, int *slow, hm_controller_output *out);
-/* A stalled robot does not drive on away from its goal: when the command c->out's motion does not bring it
- * nearer the carrot (moving, v cos(bearing to the carrot) <= 0), c->out becomes a braking plan (not a
- * protective stop). Returns 1 when it did. Walking along beside a person who crosses at the robot's own
- * speed, the paper's objective held a stalled robot at full speed, at right angles to its goal, for 45 s. */
+/* A stalled robot does not drive on away from its goal: when the command c->out moves the robot neither
+ * towards the carrot (v cos(bearing to the carrot) <= 0) nor on a plan that is nearer the carrot half a
+ * horizon on, c->out becomes a braking plan (not a protective stop). Returns 1 when it did. Walking along
+ * beside a person who crosses at the robot's own speed, the paper's objective held a stalled robot at full
+ * speed, at right angles to its goal, for 45 s (its plans there put the turn back off to their last nodes). */
 HM_FUNC int controller_stalled_command(hm_controller *c);
 
 #endif /* CONTROLLER_PROGRESS_CHECKER_H */

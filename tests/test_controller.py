@@ -366,20 +366,25 @@ def test_a_robot_that_cannot_leave_its_standstill_says_it_is_stalled(ctl: Contro
 def test_a_stalled_robot_stops_or_heads_for_its_goal_never_walks_off(ctl: Controller) -> None:
     """The paper's objective (no progress objective, no passing decisions): beside a person who crosses at the
     robot's own cruising speed, it turned and walked along with them (45 s and 40 m, stalled at full speed at
-    right angles to its goal). Stalled, the command now brakes unless it brings the robot nearer its carrot:
-    the robot stands within its braking distance of where it stalled, and says it is stalled."""
+    right angles to its goal). Stalled, the command now brakes unless it heads for the carrot: towards it, or
+    on a plan that is nearer it half a horizon on (a plan that starts off sideways to go round; braking those
+    too held a robot among standing people for 23 s). Here the robot stops, then turns and gets there."""
     ctl.set_params(progress=0, passing=0)
-    run = drive(ctl, (0.0, 0.0, 0.0), (10.0, 0.0, 0.0), people=walking((3.0, -3.0, 0.0, 0.8)), seconds=25.0)
+    run = drive(ctl, (0.0, 0.0, 0.0), (10.0, 0.0, 0.0), people=walking((3.0, -3.0, 0.0, 0.8)), seconds=45.0)
     stalled = [k for k, r in enumerate(run.results) if r.stalled]
     assert stalled, "the paper's objective no longer stalls here: the test needs another scene"
     for k in stalled:
         r, x = run.results[k], run.states[k]
-        towards = np.cos(np.arctan2(r.ocp_goal[1] - x[1], r.ocp_goal[0] - x[0]) - x[2])
+        carrot = np.asarray(r.ocp_goal[:2])
+        towards = np.cos(np.arctan2(carrot[1] - x[1], carrot[0] - x[0]) - x[2])
         braking = abs(r.command[0]) <= max(abs(x[3]) - 0.05, 0.05)  # at least half a_bounds[0] per period
-        assert r.command[0] * towards > 0 or braking, (k, x, r.command)
+        mid = np.asarray(r.plan)[len(r.plan) // 2, :2]
+        nearer = np.hypot(*(mid - carrot)) < np.hypot(*(x[:2] - carrot))
+        assert r.command[0] * towards > 0 or braking or nearer, (k, x, r.command)
     first = run.states[stalled[0]]
-    assert np.hypot(*(run.states[-1][:2] - first[:2])) <= first[3] ** 2 / (2 * 1.0) + 0.1  # a_bounds[0] = -1
-    assert run.results[-1].outcome_name == "stalled"
+    left = [np.hypot(10.0 - x[0], x[1]) for x in run.states[stalled[0]:]]
+    assert max(left) <= left[0] + first[3] ** 2 / (2 * 1.0) + 0.1  # a_bounds[0] = -1: no farther than braking
+    assert run.results[-1].goal_reached
 
 
 def test_with_the_progress_objective_a_goal_just_behind_is_reached(ctl: Controller) -> None:
