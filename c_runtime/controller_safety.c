@@ -25,18 +25,18 @@ static int controller_guard_reason(hm_controller *c, const hm_controller_input *
     hm_solver *s = &c->solver;
     const hm_input *in = &c->in;
     const hm_output *o = &c->out;
-    if (controller_nearest_track(cin, in->x0) < c->params.d_h) return HM_STOP_HUMAN_TOO_CLOSE;
+    if (controller_nearest_track(cin, in->x0) < s->params.d_h) return HM_STOP_HUMAN_TOO_CLOSE;
     if (!braking) {
         const hm_real v = o->command[0];
         const hm_real bound = controller_separation_bound(cin, in->x0, hm_cos(in->x0[2]), hm_sin(in->x0[2]), v,
-                                                          &c->params);
-        if (monitor_separation_exceeded(v, bound, &c->params)) return HM_STOP_SEPARATION;
+                                                          &s->params);
+        if (monitor_separation_exceeded(v, bound, &s->params)) return HM_STOP_SEPARATION;
     }
     {
         /* the bounds in force: the period's solver parameters, with the speed limit (without a goal the
-         * solver's are the caller's, uncapped) */
+         * solver's are the caller's, uncapped; with one, v_bounds[1] is capped already, at most the caller's) */
         hm_params bounds = s->params;
-        const hm_real cap = hm_fmin(c->params.v_bounds[1], c->params.speed_limit);
+        const hm_real cap = hm_fmin(s->params.v_bounds[1], c->params.speed_limit);
         if (cap > bounds.v_bounds[0]) bounds.v_bounds[1] = hm_fmin(bounds.v_bounds[1], cap);
         if (!monitor_command_ok(&bounds, o)) return HM_STOP_COMMAND_BOUNDS;
     }
