@@ -45,6 +45,7 @@ class Controller:
         self.name = name
         self.dims = dims
         self._ffi = ffi
+        self._lib = lib
         self.memsize = int(fn("controller_memsize")())
         sizes = ffi.new("size_t[3]")
         fn("controller_struct_sizes")(sizes + 0, sizes + 1, sizes + 2)
@@ -59,10 +60,11 @@ class Controller:
         self._c_reset = fn("controller_reset")
         self._lock = threading.Lock()
         # the controller's own parameters and its solver's, set and read by name alike
+        solver_rows = [p for p in params_table if not p.controller]
+        own_rows = [p for p in params_table if p.controller]
         self._params = RuntimeParams(ffi, lib, (
-            (f"{name}_params", fn("controller_solver_params")(self._ctl), [p for p in params_table if not p.controller]),
-            (f"{name}_controller_params", fn("controller_own_params")(self._ctl),
-             [p for p in params_table if p.controller]),
+            (f"{name}_params", fn("controller_solver_params")(self._ctl), solver_rows),
+            (f"{name}_controller_params", fn("controller_own_params")(self._ctl), own_rows),
         ), self._lock)
         self._in = ffi.new(f"{name}_controller_input *")
         self._out = ffi.new(f"{name}_controller_output *")

@@ -41,7 +41,7 @@ class RuntimeParams:
         self._lock = lock
         self._structs = [_Struct(ffi, lib, ctype, pointer, rows) for ctype, pointer, rows in structs]
         self.rows = {p.name: p for _, _, rows in structs for p in rows}
-        self._home = {p.name: s for s, (_, _, rows) in zip(self._structs, structs) for p in rows}
+        self._home = {p.name: s for s, (_, _, rows) in zip(self._structs, structs, strict=True) for p in rows}
 
     @property
     def values(self) -> dict[str, Any]:
