@@ -75,10 +75,10 @@ HM_FUNC void controller_reset(hm_controller *c)
     c->theta = HM_R(0.0);
 }
 
-HM_FUNC void controller_init(hm_controller *c, const hm_params *params)
+HM_FUNC void controller_init(hm_controller *c, const hm_params *params, const hm_controller_params *own)
 {
     int j;
-    c->params = *params;
+    c->params = *own;
     ocp_nlp_sqp_init(&c->solver, params);
     c->in.n_humans = 0;
     c->in.has_obstacle = 0;
@@ -172,7 +172,6 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
     controller_goal(cin, controller_origin(c, cin), cin->pose, in->x0[2],
                     c->params.lookahead > HM_R(0.0) ? c->params.lookahead : c->params.v_ref * horizon, &g);
     if (!g.has) {
-        s->params = c->params;
         in->goal[0] = in->x0[0];
         in->goal[1] = in->x0[1];
         in->goal[2] = in->x0[2];
@@ -203,12 +202,12 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
         const hm_real len = hm_sqrt(dx * dx + dy * dy);
         if (len > HM_R(1e-9))
             in->goal[3] = hm_fmin(in->goal[3], controller_separation_bound(cin, in->x0, dx / len, dy / len, in->goal[3],
-                                                                           &c->params));
+                                                                           &s->params));
     }
     if (c->params.progress) controller_references(c, cin, &g);
     controller_expected_path(s, cin, path);
     controller_select_people(path, cin, &s->params, hm_fmax(hm_fabs(cin->v), s->params.v_bounds[1]), in, out);
-    controller_nearest_obstacle(path, cin, c->solver.params.v_bounds[1], in);
+    controller_nearest_obstacle(path, cin, s->params.v_bounds[1], in);
     controller_goal_people(c, cin, &g, out);
     t1 = ocp_nlp_now(s);
     ocp_nlp_sqp_rti_step_from(s, in, &c->out, t0);
@@ -239,11 +238,19 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
     return 0;
 }
 
+/* 1 when both the solver's parameters and the controller's keep their rules. */
+static int controller_params_ok(const hm_controller *c)
+{
+    return monitor_check_params(&c->solver.params) && hm_controller_params_check(&c->params) == 0;
+}
+
 HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm_controller_output *out)
 {
     hm_solver *s = &c->solver;
     hm_input *in = &c->in;
     const unsigned long long t0 = ocp_nlp_now(s);
+    controller_caller_params caller;
+    controller_caller_keep(c, &caller);
     controller_clear_output(out);
     in->n_humans = 0;
     in->has_obstacle = 0;
@@ -253,11 +260,10 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
     in->x0[2] = cin->pose[2];
     in->x0[3] = cin->v;
     out->n_tracks_dropped = cin->n_tracks_dropped;
-    if (!controller_input_ok(cin) || !monitor_check_params(&c->params)) {
+    if (!controller_input_ok(cin) || !controller_params_ok(c)) {
         int i;
-        const int reason = monitor_check_params(&c->params) ? HM_STOP_INVALID_INPUT : HM_STOP_INVALID_PARAMS;
+        const int reason = controller_params_ok(c) ? HM_STOP_INVALID_INPUT : HM_STOP_INVALID_PARAMS;
         for (i = 0; i < HM_NX; i++) in->goal[i] = in->x0[i];
-        s->params = c->params;
         ocp_nlp_clear_output(&c->out);
         ocp_nlp_protective_stop(s, in, &c->out, reason);
         ocp_nlp_sqp_reset(s);
@@ -270,6 +276,7 @@ HM_FUNC int controller_step(hm_controller *c, const hm_controller_input *cin, hm
         controller_guard(c, cin, t0, braking);
     }
     controller_report(c, out);   /* a stop: the outcome "stopped", with its reason */
+    controller_caller_restore(c, &caller);
     out->time_total_ms = HM_ELAPSED_MS(ocp_nlp_now(s), t0);
     return out->outcome;
 }

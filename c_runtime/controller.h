@@ -13,7 +13,8 @@
 #define CONTROLLER_H
 #include "controller_common.h"
 
-HM_FUNC void controller_init(hm_controller *c, const hm_params *params);
+/* The solver's parameters (params) and the controller's own (own), copied. */
+HM_FUNC void controller_init(hm_controller *c, const hm_params *params, const hm_controller_params *own);
 /* Forget the episode: a cold solver, no progress history; the parameters are kept. */
 HM_FUNC void controller_reset(hm_controller *c);
 /* One control period; returns out->outcome. */

@@ -13,6 +13,7 @@
 #include "ocp_nlp_common.h"
 
 typedef HM_NS(controller) hm_controller;
+typedef HM_NS(controller_params) hm_controller_params;
 typedef HM_NS(controller_input) hm_controller_input;
 typedef HM_NS(controller_output) hm_controller_output;
 

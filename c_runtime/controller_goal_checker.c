@@ -50,7 +50,8 @@ HM_FUNC int controller_arriving(hm_controller *c, const hm_controller_goal *g)
 HM_FUNC enum controller_at_goal_state controller_at_goal(hm_controller *c, const hm_controller_input *cin,
                                                          hm_real heading)
 {
-    const hm_params *p = &c->params;
+    const hm_controller_params *p = &c->params;
+    const hm_params *sp = &c->solver.params;
     hm_output *o = &c->out;
     hm_real A[HM_NX * HM_NX], B[HM_NX * HM_NU];
     int n;
@@ -60,7 +61,7 @@ HM_FUNC enum controller_at_goal_state controller_at_goal(hm_controller *c, const
         /* brake first, then turn: turning while still rolling would swing the robot off the goal */
         const hm_real w = hm_fabs(o->x[n][3]) < CONTROLLER_AT_REST ? CONTROLLER_TURN_GAIN * (heading - o->x[n][2])
                                                                    : HM_R(0.0);
-        o->u[n][1] = hm_fmin(hm_fmax(w, p->omega_bounds[0]), p->omega_bounds[1]);
+        o->u[n][1] = hm_fmin(hm_fmax(w, sp->omega_bounds[0]), sp->omega_bounds[1]);
         hm_model_dynamics(o->x[n], o->u[n], o->x[n + 1], A, B);
     }
     o->u0[1] = o->u[0][1];

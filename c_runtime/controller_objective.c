@@ -23,32 +23,58 @@
 /* The end of the collision potential near the goal: the robot's earliest arrival within goal_tolerance from
  * rest (at v_ref or the speed cap, whichever is lower, reached at the upper acceleration bound) plus
  * arrival_margin, or the caller's collision_horizon when that is sooner. */
-static hm_real controller_arrival(const hm_params *p, const hm_params *sp, const hm_controller_goal *g)
+static hm_real controller_arrival(const hm_controller_params *p, const hm_params *sp, hm_real caller_horizon,
+                                  const hm_controller_goal *g)
 {
     const hm_real v_arrive = hm_fmin(p->v_ref, sp->v_bounds[1]);
     const hm_real arrival = hm_fmax(g->left - p->goal_tolerance, HM_R(0.0)) / v_arrive +
-                            v_arrive / (HM_R(2.0) * p->a_bounds[1]) + p->arrival_margin;
-    return hm_fmin(p->collision_horizon, arrival);
+                            v_arrive / (HM_R(2.0) * sp->a_bounds[1]) + p->arrival_margin;
+    return hm_fmin(caller_horizon, arrival);
 }
 
-/* The solver's parameters for this period: the caller's, with the speed limit and, within the
+HM_FUNC void controller_caller_keep(const hm_controller *c, controller_caller_params *caller)
+{
+    const hm_params *sp = &c->solver.params;
+    int i;
+    for (i = 0; i < HM_NX; i++) {
+        caller->w_goal[i] = sp->w_goal[i];
+        caller->w_goal_terminal[i] = sp->w_goal_terminal[i];
+    }
+    caller->v_max = sp->v_bounds[1];
+    caller->collision_horizon = sp->collision_horizon;
+}
+
+HM_FUNC void controller_caller_restore(hm_controller *c, const controller_caller_params *caller)
+{
+    hm_params *sp = &c->solver.params;
+    int i;
+    for (i = 0; i < HM_NX; i++) {
+        sp->w_goal[i] = caller->w_goal[i];
+        sp->w_goal_terminal[i] = caller->w_goal_terminal[i];
+    }
+    sp->v_bounds[1] = caller->v_max;
+    sp->collision_horizon = caller->collision_horizon;
+}
+
+/* The solver's parameters for this period: the caller's (c->solver.params holds them when the period
+ * starts; controller_caller_restore puts them back when it ends), with the speed limit and, within the
  * horizon's reach of the goal, the approach weights and the collision potential's end. Sets the goal's
  * speed (in->goal[3]). */
 HM_FUNC void controller_solver_params(hm_controller *c, const hm_controller_goal *g)
 {
-    const hm_params *p = &c->params;
+    const hm_controller_params *p = &c->params;
     hm_params *sp = &c->solver.params;
     const hm_real horizon = HM_R(HM_DT) * (hm_real)HM_N;
-    const hm_real cap = hm_fmin(p->v_bounds[1], p->speed_limit);
-    *sp = *p;
-    if (cap > p->v_bounds[0]) sp->v_bounds[1] = cap;
+    const hm_real cap = hm_fmin(sp->v_bounds[1], p->speed_limit);
+    const hm_real caller_horizon = sp->collision_horizon;
+    if (cap > sp->v_bounds[0]) sp->v_bounds[1] = cap;
     if (p->progress) {
         /* the per-node goals brake to the goal themselves (controller_references): no taper, no approach
          * weights; the potential's end at the earliest arrival as in the approach (below) */
         int i;
         for (i = 0; i < HM_NX; i++) sp->w_goal[i] = p->progress_weights[i];
         c->in.goal[3] = p->v_ref;
-        if (g->left < p->v_ref * horizon) sp->collision_horizon = controller_arrival(p, sp, g);
+        if (g->left < p->v_ref * horizon) sp->collision_horizon = controller_arrival(p, sp, caller_horizon, g);
         return;
     }
     c->in.goal[3] = hm_fmin(p->v_ref, p->goal_taper * g->left);
@@ -65,7 +91,7 @@ HM_FUNC void controller_solver_params(hm_controller *c, const hm_controller_goal
          * lower, reached at the upper acceleration bound), plus arrival_margin. Earlier nodes, the
          * distance rows (people's current positions) and the speed-and-separation bound (predictions
          * over the whole horizon) are unchanged. */
-        sp->collision_horizon = controller_arrival(p, sp, g);
+        sp->collision_horizon = controller_arrival(p, sp, caller_horizon, g);
     }
 }
 

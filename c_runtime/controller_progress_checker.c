@@ -17,7 +17,7 @@
 HM_FUNC int controller_progress(hm_controller *c, const hm_controller_input *cin, const hm_controller_goal *g,
                                 int stopped, int *slow, hm_controller_output *out)
 {
-    const hm_params *p = &c->params;
+    const hm_controller_params *p = &c->params;
     const int new_goal = !c->has_goal || hm_fabs(g->final[0] - c->goal_xy[0]) > HM_R(1e-6) ||
                          hm_fabs(g->final[1] - c->goal_xy[1]) > HM_R(1e-6);
     if (new_goal || stopped || !c->has_time || cin->time < c->time_last ||

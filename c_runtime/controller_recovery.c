@@ -51,7 +51,7 @@ static hm_real controller_plan_length(const hm_output *o)
  * times its length. */
 HM_FUNC int controller_plan_is_loop(const hm_controller *c)
 {
-    const hm_params *p = &c->params;
+    const hm_controller_params *p = &c->params;
     const hm_output *o = &c->out;
     hm_real length, dx, dy;
     if (!(p->loop_ratio > HM_R(0.0))) return 0;

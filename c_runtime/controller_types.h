@@ -5,8 +5,10 @@
  * solver, its input and output, and what it remembers between control periods.
  */
 typedef struct HM_NS(controller) {
-    HM_NS(params) params;         /* the caller's parameters: the solver's and the controller's */
-    HM_NS(solver) solver;         /* its parameters are derived from params in every period */
+    HM_NS(controller_params) params;  /* the caller's parameters of the controller */
+    HM_NS(solver) solver;         /* solver.params: the caller's parameters of the solver, between steps; a
+                                   * step changes the few it derives (controller_objective.h) and puts the
+                                   * caller's back */
     HM_NS(input) in;              /* the solver's input, built from the controller's */
     HM_NS(output) out;            /* the real-time iteration's output */
     HM_NS(output) recovery_out;   /* a recovery SQP's output */

@@ -61,7 +61,7 @@ def _cmd_build(args: argparse.Namespace) -> int:
 def static_memory(lib: Path, name: str) -> list[tuple[str, int]]:
     """(what, bytes) of the solver's and the controller's structs, as the built library reports them."""
     c = ctypes.CDLL(str(lib.resolve()))
-    sizes = [ctypes.c_size_t() for _ in range(5)]
+    sizes = [ctypes.c_size_t() for _ in range(6)]
 
     def call(fn: str, *args: object) -> int:
         f = getattr(c, f"{name}_{fn}")
@@ -77,8 +77,9 @@ def static_memory(lib: Path, name: str) -> list[tuple[str, int]]:
         (f"{name}_controller (holds its solver)", controller),
         (f"{name}_params", sizes[0].value),
         (f"{name}_input / {name}_output", sizes[1].value + sizes[2].value),
-        (f"{name}_controller_input", sizes[3].value),
-        (f"{name}_controller_output", sizes[4].value),
+        (f"{name}_controller_params", sizes[3].value),
+        (f"{name}_controller_input", sizes[4].value),
+        (f"{name}_controller_output", sizes[5].value),
     ]
 
 

@@ -41,6 +41,8 @@ _API = (
     "_solver_memory", "_solver_memsize", "_solver_params", "_solver_prepare", "_solver_reset",
     "_solver_set_clock", "_solver_solve", "_solver_step", "_controller", "_controller_create",
     "_controller_init", "_controller_input", "_controller_memsize", "_controller_output", "_controller_params",
+    "_controller_params_check", "_controller_params_default", "_controller_params_rule", "_controller_own_params",
+    "_controller_solver_params",
     "_controller_reset", "_controller_set_clock", "_controller_step", "_controller_struct_sizes", "_params",
     "_params_check", "_params_default", "_params_rule", "_input", "_output", "_real", "_clock_fn",
     "_status_message", "_qp_status_message", "_stop_reason_message", "_outcome_message",

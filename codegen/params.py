@@ -1,11 +1,14 @@
 """The runtime parameters: one table, the single source of their contract.
 
-Every field of ``<name>_params`` is a row of ``PARAMS``: its name, the spec key whose value is its
-default, its shape, unit, valid range and meaning. Derived from this table, and from nothing else:
+Every field of ``<name>_params`` (what the solver reads) and of ``<name>_controller_params`` (what
+the controller around it reads, rows with ``controller=True``) is a row of ``PARAMS``: its name, the
+spec key whose value is its default, its shape, unit, valid range and meaning. Derived from this table,
+and from nothing else:
 
 - the spec schema's rules and defaults for those keys (``humanmpc.codegen.spec``);
-- the C params struct, ``<name>_params_default`` and the C checks ``<name>_params_check`` /
-  ``<name>_params_rule`` (``templates/``), which the safety monitor applies before every step;
+- the two C params structs, their ``_default`` functions and the C checks ``<name>_params_check`` /
+  ``<name>_params_rule`` and ``<name>_controller_params_check`` / ``<name>_controller_params_rule``
+  (``templates/``), which the safety monitor and the controller apply before every step;
 - the manifest's ``params`` table, from which the Python binding's ``set_params`` checks its values;
 - the problem parameters of the Ipopt reference (rows with ``problem=True``).
 
@@ -52,7 +55,7 @@ def _num(x: float) -> str:
 
 @dataclass(frozen=True)
 class Param:
-    name: str                  # field of <name>_params, keyword of Solver.set_params
+    name: str                  # field of <name>_params (<name>_controller_params), keyword of set_params
     key: str                   # spec key path whose value is the default
     kind: str                  # one of KINDS
     default: Any               # the spec's default (the evaluation's winning value, docs/evaluation.md)
@@ -66,7 +69,7 @@ class Param:
     spec_choices: tuple[str, ...] = field(default=())  # flag set in the spec by a choice: its index is the flag
     reason: str = ""           # why the range is what it is, said with the rule
     paper: Any = None          # the paper's value, when the default is not (spec `preset: paper`)
-    controller: bool = False   # read by the controller around the solver (the solver ignores it)
+    controller: bool = False   # read by the controller around the solver: in <name>_controller_params
 
     @property
     def described(self) -> str:
@@ -165,11 +168,13 @@ class Param:
             raise ValueError(f"unknown parameter kind {row['kind']!r} in the manifest")
         return cls(name=str(row["name"]), key=str(row["key"]), kind=str(row["kind"]), default=row.get("default"),
                    doc=str(row["doc"]), unit=str(row.get("unit", "")), size=int(row["size"]),
-                   reason=str(row.get("reason", "")), valid=rng("valid"), lower=rng("lower"), upper=rng("upper"))
+                   reason=str(row.get("reason", "")), valid=rng("valid"), lower=rng("lower"), upper=rng("upper"),
+                   controller=bool(row.get("controller", False)))
 
     def manifest_row(self) -> dict[str, Any]:
         row: dict[str, Any] = {"name": self.name, "key": self.key, "kind": self.kind, "size": self.size,
-                               "unit": self.unit, "doc": self.doc, "reason": self.reason, "rule": self.rule}
+                               "unit": self.unit, "doc": self.doc, "reason": self.reason, "rule": self.rule,
+                               "controller": self.controller}
         for part in ("valid", "lower", "upper"):
             r = getattr(self, part)
             if r is not None:
@@ -327,6 +332,9 @@ PARAMS: tuple[Param, ...] = (
 
 BY_KEY: Mapping[str, Param] = {p.key: p for p in PARAMS}
 PROBLEM_PARAMS: tuple[Param, ...] = tuple(p for p in PARAMS if p.problem)
+# The fields of <name>_params and of <name>_controller_params, each in the table's order (the C checks
+# number them so: 1 + the index in their own struct).
+SOLVER_PARAMS: tuple[Param, ...] = tuple(p for p in PARAMS if not p.controller)
 CONTROLLER_PARAMS: tuple[Param, ...] = tuple(p for p in PARAMS if p.controller)
 
 

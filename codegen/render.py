@@ -13,7 +13,7 @@ import jinja2
 from . import __version__
 from .casadi_emit import EmittedFunction
 from .ocp import NU, NX
-from .params import PARAMS, Param, Range, spec_params
+from .params import CONTROLLER_PARAMS, SOLVER_PARAMS, Param, Range, spec_params
 from .resources import templates_dir
 from .spec import IDENT_RE, Spec
 from .status import status_tables
@@ -92,7 +92,8 @@ def c_identifier(name: str) -> str:
 
 @dataclass(frozen=True)
 class RuntimeParam:
-    """A field of <name>_params as the templates print it: from its row of the parameter table."""
+    """A field of <name>_params or <name>_controller_params as the templates print it: from its row of the
+    parameter table."""
 
     c_name: str
     ctype: str                      # "real" or "int"
@@ -132,11 +133,11 @@ def _c_string(text: str) -> str:
     return text
 
 
-def runtime_params(spec: Spec, real: str) -> list[RuntimeParam]:
-    """The rows of the parameter table with the spec's values as defaults."""
+def runtime_params(spec: Spec, real: str, rows: tuple[Param, ...]) -> list[RuntimeParam]:
+    """The rows (of one params struct) with the spec's values as defaults."""
     values = spec_params(spec)
     out = []
-    for p in PARAMS:
+    for p in rows:
         v = values[p.name]
         if p.ctype == "int":
             default: tuple[str, ...] | str = str(int(v))
@@ -188,7 +189,8 @@ def template_context(spec: Spec, functions: list[EmittedFunction], real: str) ->
         "runtime_sources": RUNTIME_SOURCES,
         "dt": c_float(spec.dt),
         "statuses": status_tables(),
-        "params": runtime_params(spec, {"double": "double", "float": "float"}[real]),
+        "params": runtime_params(spec, {"double": "double", "float": "float"}[real], SOLVER_PARAMS),
+        "controller_params": runtime_params(spec, {"double": "double", "float": "float"}[real], CONTROLLER_PARAMS),
         "functions": [_function_context(name, ef) for ef in functions],
     }
 

@@ -172,6 +172,7 @@ def ros_context(spec: Spec) -> dict[str, Any]:
             "doc": _c_string(f"{p.described}; must be {p.rule}"),
             "kind": p.kind if p.ctype == "int" else "real",
             "rule": _c_string(f"{p.name} must be {p.rule}"),
+            "controller": p.controller,   # a field of <name>_controller_params, not of <name>_params
         }
         for p in PARAMS
     ]

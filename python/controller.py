@@ -45,12 +45,13 @@ class Controller:
         self.name = name
         self.dims = dims
         self._ffi = ffi
+        self._lib = lib
         self.memsize = int(fn("controller_memsize")())
-        sizes = ffi.new("size_t[2]")
-        fn("controller_struct_sizes")(sizes + 0, sizes + 1)
-        declared = [ffi.sizeof(f"{name}_controller_input"), ffi.sizeof(f"{name}_controller_output")]
+        sizes = ffi.new("size_t[3]")
+        fn("controller_struct_sizes")(sizes + 0, sizes + 1, sizes + 2)
+        declared = [ffi.sizeof(f"{name}_controller_{s}") for s in ("params", "input", "output")]
         if list(sizes) != declared:
-            raise ValueError(f"{name}_cffi.h declares the controller's input/output as {declared} bytes, the "
+            raise ValueError(f"{name}_cffi.h declares the controller's params/input/output as {declared} bytes, the "
                              f"library was compiled with {list(sizes)}: regenerate and rebuild the package")
         self._mem = ffi.new("char[]", self.memsize)
         self._ctl = fn("controller_create")(self._mem)
@@ -58,7 +59,13 @@ class Controller:
         self._c_set_tracks = fn("controller_set_tracks")
         self._c_reset = fn("controller_reset")
         self._lock = threading.Lock()
-        self._params = RuntimeParams(ffi, lib, name, fn("controller_params")(self._ctl), params_table, self._lock)
+        # the controller's own parameters and its solver's, set and read by name alike
+        solver_rows = [p for p in params_table if not p.controller]
+        own_rows = [p for p in params_table if p.controller]
+        self._params = RuntimeParams(ffi, lib, (
+            (f"{name}_params", fn("controller_solver_params")(self._ctl), solver_rows),
+            (f"{name}_controller_params", fn("controller_own_params")(self._ctl), own_rows),
+        ), self._lock)
         self._in = ffi.new(f"{name}_controller_input *")
         self._out = ffi.new(f"{name}_controller_output *")
         self._out_buffer = ffi.buffer(self._out)
@@ -82,11 +89,13 @@ class Controller:
     # -- parameters ---------------------------------------------------------------------------
     @property
     def params(self) -> dict[str, Any]:
-        """The runtime parameters now in force (the solver's and the controller's)."""
+        """The runtime parameters now in force, by name: the solver's (``<name>_params``) and the controller's
+        own (``<name>_controller_params``)."""
         return self._params.values
 
     def set_params(self, **values: Any) -> None:
-        """Change runtime parameters (checked by their rules; on any error nothing changes)."""
+        """Change runtime parameters by name, the solver's and the controller's alike (checked by their rules;
+        on any error nothing changes in either)."""
         self._params.set(**values)
 
     def reset(self) -> None:

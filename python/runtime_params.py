@@ -1,43 +1,56 @@
 """The runtime parameters of a loaded solver or controller: read them, change them checked.
 
-One object per C params struct. Every value is checked against its row of the parameter table (the
-manifest's, the same rules as the spec's and the C check's) before any is written, and the C check
-has the last word on the combination; nothing is changed unless everything passes.
+One object per face: a solver's ``<name>_params``; a controller's own ``<name>_controller_params``
+together with its solver's ``<name>_params``, read and changed by name as one set. Every value is
+checked against its row of the parameter table (the manifest's, the same rules as the spec's and the C
+check's) before any is written, and each struct's C check has the last word on the combination;
+nothing is changed in any struct unless everything passes.
 """
 
 from __future__ import annotations
 
 import threading
+from collections.abc import Sequence
 from typing import Any
 
 from .codegen.params import Param
 
 
-class RuntimeParams:
-    """The ``<name>_params`` struct at ``pointer`` (owned by a solver or a controller)."""
+class _Struct:
+    """One C params struct of type ``ctype`` at ``pointer``, whose fields are ``rows``, in order."""
 
-    def __init__(self, ffi: Any, lib: Any, name: str, pointer: Any, table: tuple[Param, ...],
+    def __init__(self, ffi: Any, lib: Any, ctype: str, pointer: Any, rows: Sequence[Param]) -> None:
+        self.pointer = pointer
+        self.fields = {f: t.type for f, t in ffi.typeof(ctype).fields}
+        names = [p.name for p in rows]
+        if names != list(self.fields):
+            raise ValueError(f"the manifest's parameter table {names} does not match the library's {ctype} struct "
+                             f"{list(self.fields)}: regenerate and rebuild the package")
+        self.check = getattr(lib, f"{ctype}_check")
+        self.rule = getattr(lib, f"{ctype}_rule")
+        self.staged = ffi.new(f"{ctype} *")
+        self.size = ffi.sizeof(ctype)
+
+
+class RuntimeParams:
+    """The parameters in ``structs``: (C type, pointer to it, the table's rows that are its fields)."""
+
+    def __init__(self, ffi: Any, lib: Any, structs: Sequence[tuple[str, Any, Sequence[Param]]],
                  lock: threading.Lock) -> None:
         self._ffi = ffi
-        self._pointer = pointer
         self._lock = lock
-        self._fields = {f: t.type for f, t in ffi.typeof(f"{name}_params").fields}
-        self.rows = {p.name: p for p in table}
-        if list(self.rows) != list(self._fields):
-            raise ValueError(f"the manifest's parameter table {list(self.rows)} does not match the library's "
-                             f"params struct {list(self._fields)}")
-        self._check = getattr(lib, f"{name}_params_check")
-        self._rule = getattr(lib, f"{name}_params_rule")
-        self._staged = ffi.new(f"{name}_params *")
-        self._size = ffi.sizeof(f"{name}_params")
+        self._structs = [_Struct(ffi, lib, ctype, pointer, rows) for ctype, pointer, rows in structs]
+        self.rows = {p.name: p for _, _, rows in structs for p in rows}
+        self._home = {p.name: s for s, (_, _, rows) in zip(self._structs, structs, strict=True) for p in rows}
 
     @property
     def values(self) -> dict[str, Any]:
-        """The parameters now in force."""
+        """The parameters now in force, by name."""
         out: dict[str, Any] = {}
-        for field, ftype in self._fields.items():
-            value = getattr(self._pointer, field)
-            out[field] = tuple(value) if ftype.kind == "array" else value
+        for name in self.rows:
+            s = self._home[name]
+            value = getattr(s.pointer, name)
+            out[name] = tuple(value) if s.fields[name].kind == "array" else value
         return out
 
     def set(self, **values: Any) -> None:
@@ -60,11 +73,14 @@ class RuntimeParams:
             raise ValueError("invalid runtime parameter(s), none changed:\n  - " + "\n  - ".join(problems))
         ffi = self._ffi
         with self._lock:
-            ffi.memmove(self._staged, self._pointer, self._size)
+            for s in self._structs:
+                ffi.memmove(s.staged, s.pointer, s.size)
             for key, v in staged:
-                setattr(self._staged, key, v)
-            broken = int(self._check(self._staged))
-            if broken:
-                rule = ffi.string(self._rule(broken)).decode()
-                raise ValueError(f"invalid runtime parameter(s), none changed: {rule}")
-            ffi.memmove(self._pointer, self._staged, self._size)
+                setattr(self._home[key].staged, key, v)
+            for s in self._structs:
+                broken = int(s.check(s.staged))
+                if broken:
+                    rule = ffi.string(s.rule(broken)).decode()
+                    raise ValueError(f"invalid runtime parameter(s), none changed: {rule}")
+            for s in self._structs:
+                ffi.memmove(s.pointer, s.staged, s.size)

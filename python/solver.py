@@ -85,7 +85,10 @@ class Solver:
         # same solver memory crashed. Callers from several threads are serialised.
         self._lock = threading.Lock()
         self._table = params_table
-        self._runtime_params = RuntimeParams(ffi, lib, name, self._params, params_table, self._lock)
+        self._table_names = {p.name for p in params_table}
+        # the solver's parameters; the controller's own are its (Solver.controller())
+        self._runtime_params = RuntimeParams(
+            ffi, lib, ((f"{name}_params", self._params, [p for p in params_table if not p.controller]),), self._lock)
 
     def start_log(self, capacity: int = 10000) -> StepLog:
         """Keep the newest `capacity` steps (status, stop reason, timings, closest human) in self.log."""
@@ -224,7 +227,8 @@ class Solver:
     # -- parameters ---------------------------------------------------------------------------
     @property
     def params(self) -> dict[str, Any]:
-        """The runtime parameters now in force."""
+        """The solver's runtime parameters now in force (``<name>_params``; the controller's own are
+        ``controller().params``)."""
         return self._runtime_params.values
 
     def set_params(self, **values: Any) -> None:
@@ -233,8 +237,13 @@ class Solver:
         Every value is checked against its row of the parameter table (type, size, range: the rules of
         the spec and of the C check, named in the same words) before any is written; a ValueError
         lists every value that breaks its rule (a KeyError names unknown parameters), and nothing is
-        changed.
+        changed. The controller's own parameters (``v_ref``, ``goal_tolerance``, ...) are set on a
+        controller: ``controller().set_params``.
         """
+        own = [key for key in values if key in self._table_names and key not in self._runtime_params.rows]
+        if own:
+            raise KeyError(f"{', '.join(repr(k) for k in own)}: a parameter of the controller, not of the solver "
+                           f"(the solver does not read it): set it on the controller, solver.controller().set_params")
         self._runtime_params.set(**values)
 
     def controller(self) -> Controller:

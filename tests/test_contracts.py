@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import humanmpc
-from humanmpc.codegen.params import PARAMS, Param
+from humanmpc.codegen.params import CONTROLLER_PARAMS, PARAMS, SOLVER_PARAMS, Param
 from humanmpc.codegen.resources import runtime_dir
 from humanmpc.codegen.spec import SpecError, resolve_spec
 from humanmpc.codegen.status import StatusTableError, parse_tables, status_tables
@@ -39,12 +39,28 @@ def spec_data(p: Param, value: Any) -> dict[str, Any]:
     return {section: {key: value}}
 
 
-def c_params(solver: humanmpc.Solver) -> Any:
-    """A fresh copy of the solver's C params struct (the spec's values)."""
+def c_struct(solver: humanmpc.Solver, p: Param) -> str:
+    """The C params struct whose field p is: the solver's, or the controller's own."""
+    return f"{solver.name}_controller_params" if p.controller else f"{solver.name}_params"
+
+
+def c_index(p: Param) -> int:
+    """What the struct's check returns when p alone breaks its rule: 1 + its index in its struct."""
+    return (CONTROLLER_PARAMS if p.controller else SOLVER_PARAMS).index(p) + 1
+
+
+def c_params(solver: humanmpc.Solver, p: Param | None = None) -> Any:
+    """A fresh copy of the C params struct that holds p (default: the solver's), with the spec's values."""
     ffi, lib = solver._ffi, solver._lib
-    params = ffi.new(f"{solver.name}_params *")
-    getattr(lib, f"{solver.name}_params_default")(params)
+    struct = f"{solver.name}_params" if p is None else c_struct(solver, p)
+    params = ffi.new(f"{struct} *")
+    getattr(lib, f"{struct}_default")(params)
     return params
+
+
+def face(solver: humanmpc.Solver, p: Param) -> Any:
+    """What a Python caller sets p on: the solver, or a controller for the controller's own parameters."""
+    return solver.controller() if p.controller else solver
 
 
 @pytest.mark.parametrize("p", PARAMS, ids=[p.name for p in PARAMS])
@@ -58,29 +74,31 @@ def test_an_out_of_range_parameter_is_refused_with_the_same_rule_by_the_spec_c_a
     if p.kind != "flag":  # a flag is true/false in YAML (or a named choice), 0/1 in C and Python
         assert p.rule in str(spec_err.value), str(spec_err.value)
     # the C API
-    ffi, lib, name = paper._ffi, paper._lib, paper.name
-    params = c_params(paper)
-    assert getattr(lib, f"{name}_params_check")(params) == 0
+    ffi, lib, struct = paper._ffi, paper._lib, c_struct(paper, p)
+    params = c_params(paper, p)
+    assert getattr(lib, f"{struct}_check")(params) == 0
     setattr(params, p.name, bad)
-    which = getattr(lib, f"{name}_params_check")(params)
-    assert which == PARAMS.index(p) + 1
-    assert ffi.string(getattr(lib, f"{name}_params_rule")(which)).decode() == expected
+    which = getattr(lib, f"{struct}_check")(params)
+    assert which == c_index(p)
+    assert ffi.string(getattr(lib, f"{struct}_rule")(which)).decode() == expected
     # Python
-    before = paper.params
+    target = face(paper, p)
+    before = target.params
     with pytest.raises(ValueError) as py_err:
-        paper.set_params(**{p.name: bad})
+        target.set_params(**{p.name: bad})
     assert expected in str(py_err.value)
-    assert paper.params == before
+    assert target.params == before
 
 
 @pytest.mark.parametrize("p", [p for p in PARAMS if p.ctype == "real"], ids=lambda p: p.name)
 def test_non_finite_parameters_are_refused_by_c_and_python(paper: humanmpc.Solver, p: Param) -> None:
+    target = face(paper, p)
     for v in (math.nan, math.inf, -math.inf):
-        params = c_params(paper)
+        params = c_params(paper, p)
         setattr(params, p.name, [v] * p.size if p.size > 1 else v)
-        assert getattr(paper._lib, f"{paper.name}_params_check")(params) == PARAMS.index(p) + 1
+        assert getattr(paper._lib, f"{c_struct(paper, p)}_check")(params) == c_index(p)
         with pytest.raises(ValueError, match=re.escape(p.rule)):
-            paper.set_params(**{p.name: [v] * p.size if p.size > 1 else v})
+            target.set_params(**{p.name: [v] * p.size if p.size > 1 else v})
 
 
 def test_python_refuses_strings_and_booleans_where_c_holds_numbers(paper: humanmpc.Solver) -> None:
@@ -153,7 +171,7 @@ def test_a_lower_acceleration_bound_that_cannot_brake_is_refused_by_the_spec_c_a
         resolve_spec({"bounds": {"a": [a_min, 1.0]}})
     params = c_params(paper)
     params.a_bounds = [a_min, 1.0]
-    assert getattr(paper._lib, f"{paper.name}_params_check")(params) == PARAMS.index(p) + 1
+    assert getattr(paper._lib, f"{paper.name}_params_check")(params) == c_index(p)
     with pytest.raises(ValueError, match=re.escape(p.rule)):
         paper.set_params(a_bounds=[a_min, 1.0])
 

@@ -300,7 +300,8 @@ def _param_lines(params: dict[str, Any], real: str) -> list[str]:
         row = rows[key]
         values = list(value) if row.size > 1 else [value]
         for i, v in enumerate(values):
-            target = f"params->{key}[{i}]" if row.size > 1 else f"params->{key}"
+            struct = "own" if row.controller else "params"   # creplay_set_params(params, own)
+            target = f"{struct}->{key}[{i}]" if row.size > 1 else f"{struct}->{key}"
             text = str(int(v)) if row.ctype == "int" else _literal(float(v), real)
             lines.append(f"{target} = {text};")
     return lines

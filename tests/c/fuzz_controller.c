@@ -51,6 +51,7 @@ static S(controller) ctl;
 static S(controller_input) in;
 static S(controller_output) out;
 static S(params) spec;
+static S(controller_params) own_spec;
 
 /* xorshift64*: a seeded run replays exactly */
 static uint64_t rng_state;
@@ -101,17 +102,22 @@ static int within(double x, const double *b)
 /* Parameters for an episode: the spec's, some of them moved (always within their rules). */
 static void new_params(void)
 {
-    S(params) *p = S(controller_params)(&ctl);
+    S(params) *p = S(controller_solver_params)(&ctl);
+    S(controller_params) *o = S(controller_own_params)(&ctl);
     *p = spec;
+    *o = own_spec;
     if (chance(0.3)) p->v_bounds[0] = -between(0.1, 1.0);                 /* reversing allowed */
     if (chance(0.2)) p->a_bounds[0] = -between(0.1, 3.0);
     if (chance(0.2)) p->a_bounds[1] = between(0.1, 3.0);
     if (chance(0.2)) p->d_h = between(0.2, 1.0);
     if (chance(0.2)) p->separation = !p->separation;
-    if (chance(0.2)) p->speed_limit = between(0.2, 1.5);
+    if (chance(0.2)) o->speed_limit = between(0.2, 1.5);
     if (chance(0.1)) p->deadline_ms = between(0.01, 1.0);
-    if (chance(0.1)) p->yaw_goal_tolerance = between(0.05, 3.2);
-    if (S(params_check)(p) != 0) *p = spec;
+    if (chance(0.1)) o->yaw_goal_tolerance = between(0.05, 3.2);
+    if (S(params_check)(p) != 0 || S(controller_params_check)(o) != 0) {
+        *p = spec;
+        *o = own_spec;
+    }
 }
 
 /* A track near the robot: within d_h (sometimes), within a few metres (often), or far. */
@@ -139,9 +145,9 @@ static void new_episode(int *n_given)
     robot[0] = between(-5.0, 5.0);
     robot[1] = between(-5.0, 5.0);
     robot[2] = between(-M_PI, M_PI);
-    robot[3] = between(S(controller_params)(&ctl)->v_bounds[0], 1.2);
+    robot[3] = between(S(controller_solver_params)(&ctl)->v_bounds[0], 1.2);
     *n_given = chance(0.2) ? (int)between(0, 4) : (int)between(0, GIVEN_MAX + 1);
-    for (i = 0; i < *n_given; i++) place_track(i, S(controller_params)(&ctl)->d_h);
+    for (i = 0; i < *n_given; i++) place_track(i, S(controller_solver_params)(&ctl)->d_h);
     clock_tick = chance(0.1) ? 2000000ULL : 1000ULL;   /* 2 ms a reading: every deadline passes */
     in.has_goal = 0;
     in.n_path = 0;
@@ -168,9 +174,9 @@ static void new_episode(int *n_given)
 
 static double wrap(double a) { return atan2(sin(a), cos(a)); }
 
-static void check(double v_measured, double nearest, const S(params) *p)
+static void check(double v_measured, double nearest, const S(params) *p, const S(controller_params) *o)
 {
-    const double v_max = fmin(p->v_bounds[1], p->speed_limit);
+    const double v_max = fmin(p->v_bounds[1], o->speed_limit);
     const double v_in_force[2] = {p->v_bounds[0], v_max};
     if (!isfinite(out.command[0]) || !isfinite(out.command[1]) || !isfinite(out.u[0]) || !isfinite(out.u[1]))
         fail("a non-finite command");
@@ -199,16 +205,19 @@ int main(int argc, char **argv)
     tamper = argc > 3 && strcmp(argv[3], "tamper") == 0;
     rng_state = (argc > 2 ? strtoull(argv[2], 0, 10) : 1ULL) * 0x9E3779B97F4A7C15ULL + 1ULL;
     S(controller_create)(&ctl);
-    spec = *S(controller_params)(&ctl);
+    spec = *S(controller_solver_params)(&ctl);
+    own_spec = *S(controller_own_params)(&ctl);
     S(controller_set_clock)(&ctl, fuzz_clock, 0);
     new_episode(&n_given);
     for (steps = 0; steps < total; steps++) {
         S(params) p;
+        S(controller_params) o;
         double nearest = INFINITY;
         int bad = 0;
         if (chance(0.01)) new_episode(&n_given);
         if (chance(0.02)) new_params();
-        p = *S(controller_params)(&ctl);
+        p = *S(controller_solver_params)(&ctl);
+        o = *S(controller_own_params)(&ctl);
         for (i = 0; i < n_given; i++) {   /* people walk on; some come close, some leave */
             tracks[i][0] += DT * tracks[i][2];
             tracks[i][1] += DT * tracks[i][3];
@@ -242,17 +251,17 @@ int main(int argc, char **argv)
             out.stop = 0;   /* the oracle must see someone within d_h and no stop */
             out.stop_reason = U(STOP_NONE);
         }
-        check(in.v, nearest, &p);
+        check(in.v, nearest, &p, &o);
         if (out.outcome < 0 || out.outcome >= N_OUTCOMES) fail("an outcome outside the table");
         steps_by_outcome[out.outcome]++;
         {
             /* the situation: the final goal is the path's end, or the goal pose */
             const double gx = in.n_path > 0 ? in.path[in.n_path - 1][0] : in.goal[0];
             const double gy = in.n_path > 0 ? in.path[in.n_path - 1][1] : in.goal[1];
-            const int at_goal = hypot(gx - in.pose[0], gy - in.pose[1]) <= p.goal_tolerance;
+            const int at_goal = hypot(gx - in.pose[0], gy - in.pose[1]) <= o.goal_tolerance;
             const enum situation sit = !in.has_goal && in.n_path == 0 ? NO_GOAL
                                        : at_goal ? (in.has_goal && fabs(wrap(in.goal[2] - in.pose[2])) >
-                                                                       p.yaw_goal_tolerance ? TURNING_AT_GOAL : AT_GOAL)
+                                                                       o.yaw_goal_tolerance ? TURNING_AT_GOAL : AT_GOAL)
                                        : was_stalled ? STALLED : FOLLOWING;
             steps_by_situation[sit]++;
             if (nearest < p.d_h) {
