@@ -23,6 +23,11 @@
 #define CANDIDATE_LOOKAHEAD 5
 /* SQP iterations from a guide (a guide is no solution: one iteration leaves it far from one). */
 #define CANDIDATE_SEED_ITERATIONS 1
+/* The screening radius of a candidate's rows at every node [m], below the cold start's (the robot's reach,
+ * 5.5 m by the horizon's end, whose QPs held 217 rows at 30 people against the main plan's 55): the step
+ * from a guide moves its nodes far less, and a row the step violates joins the QP all the same
+ * (ocp_nlp_screen.c), so the radius changes the work, not the solution. */
+#define CANDIDATE_SCREEN_RADIUS HM_R(1.5)
 
 #if HM_NCAND > 1
 
@@ -105,6 +110,7 @@ static void candidate_guide(hm_solver *s, const hm_input *in, int j, hm_real sid
     s->dyn_fresh = 1;
     ocp_qp_sol_set_zero(&s->mult);
     ocp_nlp_screen_reach(s);
+    for (n = 0; n <= HM_N; n++) s->screen_radius[n] = hm_fmin(s->screen_radius[n], CANDIDATE_SCREEN_RADIUS);
     s->warm = 1;
 }
 
@@ -133,7 +139,8 @@ HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, 
 {
     hm_solver *s = &c->solver;
     const hm_input *in = &c->in;
-    const hm_real tol = hm_fmax(s->params.qp_tol, HM_R(1e-6));
+    /* its QP to params.qp_tol, the main plan's (the line search's QP: to min(qp_tol, 0.1 tol)) */
+    const hm_real tol = HM_R(10.0) * s->params.qp_tol;
     int usable[HM_NCAND], id[HM_NCAND], side[HM_NCAND], buffer[HM_NCAND];
     hm_real cost[HM_NCAND];
     int k, best = -1, last = -1, ok = 0, kept = 0;
@@ -161,7 +168,7 @@ HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, 
              * refused it in the first period of an episode and after periods without it. */
             ocp_nlp_sqp_reset(s);
             candidate_guide(s, in, j, (hm_real)side[k]);
-            ocp_nlp_sqp_solve_timed(s, in, &c->candidate_out[buffer[k]], CANDIDATE_SEED_ITERATIONS, tol, t0);
+            ocp_nlp_sqp_candidate_step(s, in, &c->candidate_out[buffer[k]], CANDIDATE_SEED_ITERATIONS, tol, t0);
             usable[k] = candidate_usable(&c->candidate_out[buffer[k]]);
             cost[k] = c->candidate_out[buffer[k]].cost;
         }

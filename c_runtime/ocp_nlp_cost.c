@@ -99,6 +99,15 @@ HM_FUNC hm_real ocp_nlp_slack_penalty(hm_real g, hm_real l1, hm_real l2)
     return l1 * sl + HM_R(0.5) * l2 * sl * sl;
 }
 
+/* 1 when row r cannot need slack at the node x: its plain distance beyond d_min by a millimetre, the
+ * smooth distance of the model being at least the plain one (g > 0, a penalty of exactly 0, which the
+ * sums need not add: skipping it changes no bit of them). */
+static int ocp_nlp_row_slack_free(const hm_real *x, const ocp_nlp_row *r)
+{
+    const hm_real dx = x[0] - r->c[0], dy = x[1] - r->c[1], near = *r->d_min + HM_R(1e-3);
+    return dx * dx + dy * dy > near * near;
+}
+
 HM_FUNC hm_real ocp_nlp_separation_penalty(const hm_solver *s)
 {
     hm_real excess = HM_R(0.0);
@@ -124,9 +133,33 @@ HM_FUNC hm_real ocp_nlp_objective(const hm_solver *s, const hm_input *in)
         for (j = 0; j < t.ng; j++) {
             const ocp_nlp_row r = ocp_nlp_row_of(p, in, t.nh, j);
             hm_real g, jac[HM_NPOS], hess_d[HM_NPOS * HM_NPOS];
+            if (ocp_nlp_row_slack_free(x, &r)) continue;   /* adds 0 */
             hm_model_distance_constraint(x, r.c, r.d_min, &g, jac, hess_d);
             cost += ocp_nlp_slack_penalty(g, r.l1, r.l2);
         }
     }
     return cost + ocp_nlp_separation_penalty(s);
+}
+
+HM_FUNC hm_real ocp_nlp_plan_cost(const hm_solver *s, const hm_input *in, int exact)
+{
+    const hm_params *p = &s->params;
+    const ocp_nlp_terms t = ocp_nlp_cost_terms(p, in);
+    hm_real cost = HM_R(0.0), penalty = HM_R(0.0);
+    int n, j;
+    for (n = 0; n <= HM_N; n++) {
+        const hm_real *x = s->x[n];
+        hm_real gx[HM_NX], hx[HM_NX * HM_NX], gu[HM_NU], hu[HM_NU * HM_NU];
+        cost += ocp_nlp_cost_tracking(p, in, n, x, n < HM_N ? s->u[n] : 0, gx, gu, hx, hu);
+        cost = ocp_nlp_cost_people(p, in, &t, n, x, exact, cost, 0, 0);
+        if (n == 0) continue;
+        for (j = 0; j < t.ng; j++) {
+            const ocp_nlp_row r = ocp_nlp_row_of(p, in, t.nh, j);
+            hm_real g, jac[HM_NPOS], hess_d[HM_NPOS * HM_NPOS];
+            if (ocp_nlp_row_slack_free(x, &r)) continue;   /* adds 0 */
+            hm_model_distance_constraint(x, r.c, r.d_min, &g, jac, hess_d);
+            penalty += ocp_nlp_slack_penalty(g, r.l1, r.l2);
+        }
+    }
+    return cost + penalty;
 }

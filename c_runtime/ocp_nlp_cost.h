@@ -57,6 +57,13 @@ HM_FUNC hm_real ocp_nlp_separation_penalty(const hm_solver *s);
  * zero, left out). */
 HM_FUNC hm_real ocp_nlp_objective(const hm_solver *s, const hm_input *in);
 
+/* The objective of the iterate s->x, s->u as ocp_nlp_linearize adds it up into s->cost (exact: its
+ * Hessian flag, which picks the collision potential's evaluation), bit for bit, without the derivatives
+ * and without the separation penalty (ocp_nlp_set_x0 adds it): tracking and collision potential node by
+ * node, the rows' slack penalties summed apart. A row keeps its slack at zero, adding nothing, when its
+ * plain distance is beyond d_min (the smooth distance is at least the plain one), and is not evaluated. */
+HM_FUNC hm_real ocp_nlp_plan_cost(const hm_solver *s, const hm_input *in, int exact);
+
 /* 1 when node n is within the collision potential's horizon (params collision_horizon): later nodes
  * carry no collision cost. */
 HM_FUNC int ocp_nlp_collision_node(const hm_params *p, int n);

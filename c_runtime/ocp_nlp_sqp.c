@@ -6,6 +6,8 @@
  */
 #include "ocp_nlp_sqp.h"
 
+#include "monitor.h"
+#include "ocp_nlp_cost.h"
 #include "ocp_nlp_lin.h"
 #include "ocp_nlp_out.h"
 #include "ocp_nlp_step.h"
@@ -57,14 +59,35 @@ HM_FUNC void ocp_nlp_sqp_reset(hm_solver *s)
      * the controller's nudged recovery does, compares with it) */
 }
 
+/* How the SQP is run: as the reference (tests, recoveries), or for a candidate plan
+ * (ocp_nlp_sqp_candidate_step: its QPs with the recurrence, none of the residuals). */
+enum ocp_nlp_sqp_mode { OCP_NLP_SQP_REFERENCE, OCP_NLP_SQP_CANDIDATE };
+
+/* The cost the reference reports after its last iteration (its final linearisation with the exact
+ * Hessian, then ocp_nlp_set_x0), bit for bit, without the linearisation: the speed-and-separation bounds
+ * of the iterate, then the objective as that linearisation adds it up. */
+static void ocp_nlp_sqp_final_cost(hm_solver *s, const hm_input *in)
+{
+    const hm_params *p = &s->params;
+    int n;
+    if (p->separation)
+        for (n = 2; n <= HM_N; n++)
+            s->v_separation[n] = monitor_separation_bound(in, p, s->x[n - 1], n - 1, p->v_bounds[1]);
+    s->cost = ocp_nlp_plan_cost(s, in, 1);
+    s->cost_slack = HM_R(0.0);
+    ocp_nlp_set_x0(s, in);
+}
+
 /* Under the same monitors as the real-time iteration: the inputs and parameters before, the deadline of
  * params.deadline_ms from t0 (polled inside the QPs and between the iterations), every QP solved (one
  * stopped at its iteration limit, infeasible or failed ends the SQP, its iterate not applied), the
  * clock, C1 / C2 on the plan and the command guard; each failure a protective stop. max_iter < 1 or a
- * tolerance that is not a positive finite number is an invalid input: nothing is solved. */
+ * tolerance that is not a positive finite number is an invalid input: nothing is solved. A candidate's
+ * step (ocp_nlp_sqp.h) differs where marked. */
 static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
-                               unsigned long long t0)
+                               unsigned long long t0, enum ocp_nlp_sqp_mode mode)
 {
+    const int reference = mode == OCP_NLP_SQP_REFERENCE;
     int k, qp_status = HM_QP_SOLVED, status = HM_STATUS_MAX_ITER, reason, late = 0;
     ocp_nlp_clear_output(out);
     ocp_nlp_step_counts_reset(s);
@@ -88,7 +111,7 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
      * the residuals far below the QP tolerance, which is relative to the scaled data; with the
      * recurrence they end just below it, and at tol = 1e-9 the SQP stalled on that (stationarity
      * 3.5e-7 after 300 iterations, 30 people). */
-    s->ipm_arg.recurrence = 0;
+    s->ipm_arg.recurrence = !reference;   /* a candidate's QP: with the recurrence, as the RTI's */
     /* and all of them from the cold start (keeping none, so the next RTI step starts cold too) */
     s->ipm_arg.warm_mu = HM_R(0.0);
     ocp_nlp_start_clock(s, t0);
@@ -101,8 +124,8 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
         }
         ocp_nlp_linearize(s, in, k > 0);
         ocp_nlp_set_x0(s, in);
-        ocp_nlp_residuals(s, out);
-        if (k > 0 && out->kkt_stat <= tol && out->kkt_eq <= tol && out->kkt_ineq <= tol && out->kkt_comp <= tol) {
+        if (reference) ocp_nlp_residuals(s, out);   /* a candidate's are tested by no one */
+        if (reference && k > 0 && out->kkt_stat <= tol && out->kkt_eq <= tol && out->kkt_ineq <= tol && out->kkt_comp <= tol) {
             status = HM_STATUS_OK;
             break;
         }
@@ -115,7 +138,11 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
     }
     s->ipm_arg.should_stop = 0;
     s->ipm_arg.stop_ctx = 0;
-    if (k == max_iter) {
+    if (k == max_iter && !reference) {
+        /* a candidate: its cost at the final iterate, which the plans are compared by (max_iter iterations,
+         * untested: HM_STATUS_MAX_ITER) */
+        ocp_nlp_sqp_final_cost(s, in);
+    } else if (k == max_iter) {
         /* Report the residuals at the final iterate. */
         ocp_nlp_linearize(s, in, 1);
         ocp_nlp_set_x0(s, in);
@@ -148,13 +175,19 @@ static int ocp_nlp_sqp_iterate(hm_solver *s, const hm_input *in, hm_output *out,
 
 HM_FUNC int ocp_nlp_sqp_solve(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol)
 {
-    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, ocp_nlp_now(s));
+    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, ocp_nlp_now(s), OCP_NLP_SQP_REFERENCE);
 }
 
 HM_FUNC int ocp_nlp_sqp_solve_timed(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
                                     unsigned long long t0)
 {
-    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, t0);
+    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, t0, OCP_NLP_SQP_REFERENCE);
+}
+
+HM_FUNC int ocp_nlp_sqp_candidate_step(hm_solver *s, const hm_input *in, hm_output *out, int max_iter, hm_real tol,
+                                       unsigned long long t0)
+{
+    return ocp_nlp_sqp_iterate(s, in, out, max_iter, tol, t0, OCP_NLP_SQP_CANDIDATE);
 }
 
 HM_FUNC const char *ocp_nlp_status_message(int status)
