@@ -117,17 +117,22 @@ HM_FUNC hm_real ocp_nlp_separation_penalty(const hm_solver *s)
     return s->params.human_slack_l1 * excess;
 }
 
-HM_FUNC hm_real ocp_nlp_objective(const hm_solver *s, const hm_input *in)
+/* The objective of the iterate s->x, s->u without the separation penalty, node by node: tracking, the
+ * collision potential (exact: its Hessian flag), and the rows' slack penalties, added into the running sum
+ * (rows_apart = 0: the line search's merit) or into a sum of their own added at the end (rows_apart = 1:
+ * as ocp_nlp_linearize adds up s->cost). Two orders of the same terms, each its caller's bit for bit. */
+static hm_real ocp_nlp_cost_sum(const hm_solver *s, const hm_input *in, int exact, int rows_apart)
 {
     const hm_params *p = &s->params;
     const ocp_nlp_terms t = ocp_nlp_cost_terms(p, in);
-    hm_real cost = HM_R(0.0);
+    hm_real cost = HM_R(0.0), penalty = HM_R(0.0);
+    hm_real *rows = rows_apart ? &penalty : &cost;
     int n, j;
     for (n = 0; n <= HM_N; n++) {
         const hm_real *x = s->x[n];
         hm_real gx[HM_NX], hx[HM_NX * HM_NX], gu[HM_NU], hu[HM_NU * HM_NU];
         cost += ocp_nlp_cost_tracking(p, in, n, x, n < HM_N ? s->u[n] : 0, gx, gu, hx, hu);
-        cost = ocp_nlp_cost_people(p, in, &t, n, x, 0, cost, 0, 0);
+        cost = ocp_nlp_cost_people(p, in, &t, n, x, exact, cost, 0, 0);
         /* node 0 is the measured state: its rows cannot be acted on */
         if (n == 0) continue;
         for (j = 0; j < t.ng; j++) {
@@ -135,31 +140,18 @@ HM_FUNC hm_real ocp_nlp_objective(const hm_solver *s, const hm_input *in)
             hm_real g, jac[HM_NPOS], hess_d[HM_NPOS * HM_NPOS];
             if (ocp_nlp_row_slack_free(x, &r)) continue;   /* adds 0 */
             hm_model_distance_constraint(x, r.c, r.d_min, &g, jac, hess_d);
-            cost += ocp_nlp_slack_penalty(g, r.l1, r.l2);
+            *rows += ocp_nlp_slack_penalty(g, r.l1, r.l2);
         }
     }
-    return cost + ocp_nlp_separation_penalty(s);
+    return rows_apart ? cost + penalty : cost;
+}
+
+HM_FUNC hm_real ocp_nlp_objective(const hm_solver *s, const hm_input *in)
+{
+    return ocp_nlp_cost_sum(s, in, 0, 0) + ocp_nlp_separation_penalty(s);
 }
 
 HM_FUNC hm_real ocp_nlp_plan_cost(const hm_solver *s, const hm_input *in, int exact)
 {
-    const hm_params *p = &s->params;
-    const ocp_nlp_terms t = ocp_nlp_cost_terms(p, in);
-    hm_real cost = HM_R(0.0), penalty = HM_R(0.0);
-    int n, j;
-    for (n = 0; n <= HM_N; n++) {
-        const hm_real *x = s->x[n];
-        hm_real gx[HM_NX], hx[HM_NX * HM_NX], gu[HM_NU], hu[HM_NU * HM_NU];
-        cost += ocp_nlp_cost_tracking(p, in, n, x, n < HM_N ? s->u[n] : 0, gx, gu, hx, hu);
-        cost = ocp_nlp_cost_people(p, in, &t, n, x, exact, cost, 0, 0);
-        if (n == 0) continue;
-        for (j = 0; j < t.ng; j++) {
-            const ocp_nlp_row r = ocp_nlp_row_of(p, in, t.nh, j);
-            hm_real g, jac[HM_NPOS], hess_d[HM_NPOS * HM_NPOS];
-            if (ocp_nlp_row_slack_free(x, &r)) continue;   /* adds 0 */
-            hm_model_distance_constraint(x, r.c, r.d_min, &g, jac, hess_d);
-            penalty += ocp_nlp_slack_penalty(g, r.l1, r.l2);
-        }
-    }
-    return cost + penalty;
+    return ocp_nlp_cost_sum(s, in, exact, 1);
 }
