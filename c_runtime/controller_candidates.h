@@ -2,7 +2,7 @@
  * controller_candidates.h: passing decisions (controller_candidates.c). Beside the main plan (the
  * real-time iteration warm from its own last solution), HM_NCAND - 1 candidate plans each pass one of the
  * people the OCP sees on one side (left, right of the first person, then of the second, ...): each starts
- * from a guide that goes round that person on its side, in every period, and takes a few SQP iterations of
+ * from a guide that goes round that person on its side, in every period, and takes one SQP iteration of
  * the same fixed-size solver within the period's deadline. The cheapest plan that passes the monitors is
  * applied, with hysteresis: another plan replaces the passing decision applied last period (that person on
  * that side, or the main plan) only when it costs less by candidate_hysteresis (a fraction). HM_NCAND = 1:
