@@ -9,6 +9,8 @@
  */
 #include "controller_candidates.h"
 
+#include "controller_safety.h"
+
 #include "ocp_nlp_iterate.h"
 #include "ocp_nlp_lin.h"
 #include "ocp_nlp_rti.h"
@@ -114,10 +116,12 @@ static void candidate_guide(hm_solver *s, const hm_input *in, int j, hm_real sid
     s->warm = 1;
 }
 
-/* 1 when a plan may be applied: no stop, its QP solved. */
-static int candidate_usable(const hm_output *o)
+/* 1 when a plan may be applied: no stop, its QP solved, and the guard's tests of a moving plan passed (a
+ * plan the guard would stop is no choice while another passes: in a crowd the cheapest plan was stopped
+ * in time and the people walked into the robot at rest while a plan that stepped aside passed). */
+static int candidate_usable(const hm_controller *c, const hm_controller_input *cin, const hm_output *o)
 {
-    return !o->stop && o->qp_status == HM_QP_SOLVED;
+    return !o->stop && o->qp_status == HM_QP_SOLVED && controller_moving_plan_reason(c, cin, o) == HM_STOP_NONE;
 }
 
 HM_FUNC void controller_candidates_reset(hm_controller *c)
@@ -135,7 +139,8 @@ static int candidate_free_buffer(const int *buffer, int best, int last)
         if (!(best > 0 && buffer[best] == b) && !(last > 0 && buffer[last] == b)) return b;
 }
 
-HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, hm_controller_output *out)
+HM_FUNC int controller_candidates_step(hm_controller *c, const hm_controller_input *cin, unsigned long long t0,
+                                       hm_controller_output *out)
 {
     hm_solver *s = &c->solver;
     const hm_input *in = &c->in;
@@ -152,7 +157,7 @@ HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, 
         side[k] = k == 0 ? 0 : (k - 1) % 2 == 0 ? 1 : -1;
         id[k] = k == 0 ? -1 : j < in->n_humans ? out->people_ids[j] : -1;
         if (k == 0) {
-            usable[0] = candidate_usable(&c->out);
+            usable[0] = candidate_usable(c, cin, &c->out);
             cost[0] = c->out.cost;
         } else if (j < in->n_humans && c->params.passing) {
             if (!kept) {
@@ -169,7 +174,7 @@ HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, 
             ocp_nlp_sqp_reset(s);
             candidate_guide(s, in, j, (hm_real)side[k]);
             ocp_nlp_sqp_candidate_step(s, in, &c->candidate_out[buffer[k]], CANDIDATE_SEED_ITERATIONS, tol, t0);
-            usable[k] = candidate_usable(&c->candidate_out[buffer[k]]);
+            usable[k] = candidate_usable(c, cin, &c->candidate_out[buffer[k]]);
             cost[k] = c->candidate_out[buffer[k]].cost;
         }
         /* in the order of the indices, as over all of them at the end: the first of the lowest cost, the
@@ -201,8 +206,10 @@ HM_FUNC void controller_candidates_reset(hm_controller *c)
     c->chosen_side = 0;
 }
 
-HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, hm_controller_output *out)
+HM_FUNC int controller_candidates_step(hm_controller *c, const hm_controller_input *cin, unsigned long long t0,
+                                       hm_controller_output *out)
 {
+    (void)cin;
     (void)t0;
     out->candidate = 0;
     out->candidates_ok = !c->out.stop && c->out.qp_status == HM_QP_SOLVED;

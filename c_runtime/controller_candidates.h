@@ -3,9 +3,10 @@
  * real-time iteration warm from its own last solution), HM_NCAND - 1 candidate plans each pass one of the
  * people the OCP sees on one side (left, right of the first person, then of the second, ...): each starts
  * from a guide that goes round that person on its side, in every period, and takes one SQP iteration of
- * the same fixed-size solver within the period's deadline. The cheapest plan that passes the monitors is
- * applied, with hysteresis: another plan replaces the passing decision applied last period (that person on
- * that side, or the main plan) only when it costs less by candidate_hysteresis (a fraction). HM_NCAND = 1:
+ * the same fixed-size solver within the period's deadline. The cheapest plan that passes the monitors and
+ * the guard's tests of a moving plan (controller_safety.h) is applied, with hysteresis: another plan
+ * replaces the passing decision applied last period (that person on that side, or the main plan) only when
+ * it costs less by candidate_hysteresis (a fraction). HM_NCAND = 1:
  * the main plan alone, and nothing here runs.
  *
  * Memory: the candidates are solved one after the other in the main plan's solver, its warm start kept
@@ -24,6 +25,7 @@ HM_FUNC void controller_candidates_reset(hm_controller *c);
  * period set): solves the candidates and, when one is chosen, copies its plan into c->out. Reports the
  * chosen plan (out->candidate: 0 the main one) and how many passed the monitors. Returns the chosen index.
  * t0: the period's first clock reading (the deadline's origin). */
-HM_FUNC int controller_candidates_step(hm_controller *c, unsigned long long t0, hm_controller_output *out);
+HM_FUNC int controller_candidates_step(hm_controller *c, const hm_controller_input *cin, unsigned long long t0,
+                                       hm_controller_output *out);
 
 #endif /* CONTROLLER_CANDIDATES_H */

@@ -60,6 +60,18 @@ static int controller_stop_comes_too_late(const hm_solver *s, const hm_input *in
     return 0;
 }
 
+HM_FUNC int controller_moving_plan_reason(const hm_controller *c, const hm_controller_input *cin, const hm_output *o)
+{
+    const hm_solver *s = &c->solver;
+    const hm_input *in = &c->in;
+    const hm_real v = o->command[0];
+    const hm_real bound = controller_separation_bound(cin, in->x0, hm_cos(in->x0[2]), hm_sin(in->x0[2]), v,
+                                                      &s->params);
+    if (monitor_separation_exceeded(v, bound, &s->params)) return HM_STOP_SEPARATION;
+    if (s->params.separation && controller_stop_comes_too_late(s, in, o)) return HM_STOP_PREDICTED_CONTACT;
+    return HM_STOP_NONE;
+}
+
 /* The first test of controller_guard that fails, HM_STOP_NONE when all pass. */
 static int controller_guard_reason(hm_controller *c, const hm_controller_input *cin, unsigned long long t0,
                                    int braking)
@@ -69,11 +81,8 @@ static int controller_guard_reason(hm_controller *c, const hm_controller_input *
     const hm_output *o = &c->out;
     if (controller_nearest_track(cin, in->x0) < s->params.d_h) return HM_STOP_HUMAN_TOO_CLOSE;
     if (!braking) {
-        const hm_real v = o->command[0];
-        const hm_real bound = controller_separation_bound(cin, in->x0, hm_cos(in->x0[2]), hm_sin(in->x0[2]), v,
-                                                          &s->params);
-        if (monitor_separation_exceeded(v, bound, &s->params)) return HM_STOP_SEPARATION;
-        if (s->params.separation && controller_stop_comes_too_late(s, in, o)) return HM_STOP_PREDICTED_CONTACT;
+        const int reason = controller_moving_plan_reason(c, cin, o);
+        if (reason != HM_STOP_NONE) return reason;
     }
     {
         /* the bounds in force: the period's solver parameters, with the speed limit (without a goal the

@@ -30,6 +30,10 @@
 /* Distance from the point p to the nearest of the controller's tracks (all of them; HM_INF without). */
 HM_FUNC hm_real controller_nearest_track(const hm_controller_input *cin, const hm_real *p);
 
+/* The tests of a plan that moves, on the solver's output o of this period (c->in, the solver's parameters
+ * set): speed and separation on every track, then the stop in time; HM_STOP_NONE when both pass. The
+ * guard applies them to the plan applied, the candidates' choice to every plan it may apply. */
+HM_FUNC int controller_moving_plan_reason(const hm_controller *c, const hm_controller_input *cin, const hm_output *o);
 /* The period's last word on c->out (see above): a protective stop replaces it when one of the tests
  * fails; a stop already in force is kept with its reason. braking: 1 when c->out is the controller's own
  * braking plan (at the goal, without a goal), which the speed-and-separation test leaves alone: a stop

@@ -141,7 +141,7 @@ class ControllerResult:
     people_ids, people_index, predictions (N + 1, n_people, 2): the tracks the OCP used
     n_tracks_dropped    people given beyond max_tracks and left out (the farthest)
     candidate           the plan applied (0: the main plan; k: the k-th candidate passing someone), and
-                        candidates_ok, how many plans passed the monitors
+                        candidates_ok, how many plans passed the monitors and the guard's tests of a moving plan
     obstacle            the obstacle point the OCP kept d_s from, or None
     distance_to_goal [m], time_without_progress [s], min_human_distance [m]
     time_ms, time_solver_ms, time_recovery_ms

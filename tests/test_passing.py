@@ -18,7 +18,10 @@ import pytest
 
 import humanmpc
 from humanmpc.controller import Controller
+from humanmpc.eval.episode import EpisodeConfig, run_episode
+from humanmpc.planners.mpc import MPCPlanner
 from humanmpc.sim.robot import RobotModel, step
+from humanmpc.sim.scenarios import make_scenario
 from tests.conftest import make_solver
 
 DT = 0.1
@@ -148,3 +151,53 @@ def test_the_candidates_run_in_the_first_period_of_an_episode_that_starts_elsewh
     again = c.step(0.0, pose=np.array([20.0, 5.0, 0.0]), v=0.0, goal=(30.0, 5.0, 0.0),
                    people=person + np.array([20.0, 5.0, 0.0, 0.0]))
     assert first.candidates_ok == again.candidates_ok == 3, (first.candidates_ok, again.candidates_ok)
+
+
+def test_a_person_standing_just_beyond_d_h_between_the_robot_and_its_goal_is_gone_round(passing_dir: Path) -> None:
+    """The end of a square crossing (social force, tuning seed 147, 10 people): the people stand at their
+    goals, one 0.52 m from the robot on the way to its goal. The progress objective's speed to track,
+    lowered by speed and separation towards the goal to 0.06 m/s, left the path's goals creeping and the robot
+    standing 18 s, facing either way; it is lowered at most to half of itself, and the plan goes round."""
+    c = humanmpc.load(passing_dir).controller()
+    people = np.array([[0.16, 2.71, 0.0, 0.0], [-0.92, 3.22, 0.0, 0.0], [2.34, 2.65, 0.0, 0.0],
+                       [1.28, 0.64, 0.0, 0.0]])
+    goal = (0.0, 4.0, 1.57)
+    for heading in (1.22, 0.41):
+        c.reset()
+        x, model, closest = np.array([0.57, 2.39, heading, 0.0]), RobotModel(), np.inf
+        for k in range(150):
+            r = c.step(k * DT, pose=x[:3], v=x[3], goal=goal, people=people)
+            if r.goal_reached:
+                break
+            if abs(x[3]) > 0.05:
+                closest = min(closest, float(np.min(np.hypot(*(people[:, :2] - x[:2]).T))))
+            x = step(model, x, r.u, DT)
+        assert r.goal_reached, f"heading {heading}: at {np.round(x, 2)} after 15 s"
+        assert closest >= D_H, f"{closest:.2f} m from someone while moving"
+
+
+def test_the_guard_stops_a_moving_plan_only_when_no_plan_passes_its_tests(passing_dir: Path) -> None:
+    """A plan that the guard would stop (speed and separation, the stop in time) is no choice while another
+    passes: the candidates' choice applies the guard's tests of a moving plan to every plan. Before, the
+    cheapest plan was applied and stopped while another passed (20 people walking across a square, social
+    force, tuning seed 101); now a stop for those tests comes only with no plan passing them (candidates_ok,
+    the plans that pass, is 0)."""
+    guard_stops, with_a_plan = 0, []
+    for seed in (101, 104, 105):
+        planner = MPCPlanner(humanmpc.load(passing_dir), params={"deadline_ms": 1000.0})
+        plan = planner.plan
+
+        def checked(obs, plan=plan, planner=planner, seed=seed):
+            nonlocal guard_stops
+            u = plan(obs)
+            r = planner.last
+            if r.stop and r.reason in ("separation", "predicted_contact"):
+                guard_stops += 1
+                if r.candidates_ok > 0:
+                    with_a_plan.append((seed, round(obs.time, 1), r.reason, r.candidates_ok))
+            return u
+
+        planner.plan = checked
+        run_episode(make_scenario("crowdnav_square_20", seed), planner, EpisodeConfig(crowd_model="social_force"))
+    assert guard_stops > 0, "no stop of a moving plan: the scenes no longer test the choice"
+    assert not with_a_plan, with_a_plan
