@@ -31,6 +31,14 @@
  * (ocp_nlp_screen.c), so the radius changes the work, not the solution. */
 #define CANDIDATE_SCREEN_RADIUS HM_R(1.5)
 
+/* 1 when a plan may be applied: no stop, its QP solved, and the guard's tests of a moving plan passed (a
+ * plan the guard would stop is no choice while another passes: in a crowd the cheapest plan was stopped
+ * in time and the people walked into the robot at rest while a plan that stepped aside passed). */
+static int candidate_usable(const hm_controller *c, const hm_controller_input *cin, const hm_output *o)
+{
+    return !o->stop && o->qp_status == HM_QP_SOLVED && controller_moving_plan_reason(c, cin, o) == HM_STOP_NONE;
+}
+
 #if HM_NCAND > 1
 
 /* The route's point at node n: the per-node goal (the progress objective), else the carrot approached at
@@ -114,14 +122,6 @@ static void candidate_guide(hm_solver *s, const hm_input *in, int j, hm_real sid
     ocp_nlp_screen_reach(s);
     for (n = 0; n <= HM_N; n++) s->screen_radius[n] = hm_fmin(s->screen_radius[n], CANDIDATE_SCREEN_RADIUS);
     s->warm = 1;
-}
-
-/* 1 when a plan may be applied: no stop, its QP solved, and the guard's tests of a moving plan passed (a
- * plan the guard would stop is no choice while another passes: in a crowd the cheapest plan was stopped
- * in time and the people walked into the robot at rest while a plan that stepped aside passed). */
-static int candidate_usable(const hm_controller *c, const hm_controller_input *cin, const hm_output *o)
-{
-    return !o->stop && o->qp_status == HM_QP_SOLVED && controller_moving_plan_reason(c, cin, o) == HM_STOP_NONE;
 }
 
 HM_FUNC void controller_candidates_reset(hm_controller *c)
@@ -209,10 +209,9 @@ HM_FUNC void controller_candidates_reset(hm_controller *c)
 HM_FUNC int controller_candidates_step(hm_controller *c, const hm_controller_input *cin, unsigned long long t0,
                                        hm_controller_output *out)
 {
-    (void)cin;
     (void)t0;
     out->candidate = 0;
-    out->candidates_ok = !c->out.stop && c->out.qp_status == HM_QP_SOLVED;
+    out->candidates_ok = candidate_usable(c, cin, &c->out);
     return 0;
 }
 

@@ -23,7 +23,8 @@ HM_FUNC void controller_candidates_reset(hm_controller *c);
 
 /* After the main plan's real-time iteration into c->out (c->in and the solver's parameters of this
  * period set): solves the candidates and, when one is chosen, copies its plan into c->out. Reports the
- * chosen plan (out->candidate: 0 the main one) and how many passed the monitors. Returns the chosen index.
+ * chosen plan (out->candidate: 0 the main one) and how many plans passed the monitors and the guard's
+ * tests of a moving plan (one plan too). Returns the chosen index.
  * t0: the period's first clock reading (the deadline's origin). */
 HM_FUNC int controller_candidates_step(hm_controller *c, const hm_controller_input *cin, unsigned long long t0,
                                        hm_controller_output *out);
