@@ -72,6 +72,8 @@ HM_FUNC void controller_reset(hm_controller *c)
     c->has_recovery = 0;
     c->has_theta = 0;
     c->has_origin = 0;
+    c->has_lead = 0;
+    c->lead = HM_R(0.0);
     c->arriving = 0;
     controller_candidates_reset(c);
     c->best_left = HM_INF;

@@ -29,6 +29,13 @@ typedef struct HM_NS(controller) {
     int has_origin;
     HM_REAL origin[2];
     HM_REAL origin_goal[2];
+    /* The progress objective's lead (controller_references): how far along the path its goals start ahead
+     * of the robot's projection; the distance left, the time and the goal of the period that set it. */
+    int has_lead;
+    HM_REAL lead;
+    HM_REAL lead_left;
+    HM_REAL lead_time;
+    HM_REAL lead_goal[2];
     /* Passing decisions (controller_candidates.h): the other candidate plans are solved one after the other
      * in the solver's own memory, its warm start kept aside meanwhile (main_kept); of their outputs only
      * those that may still be applied are kept (the cheapest so far, the decision of last period, and the one

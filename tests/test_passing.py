@@ -176,6 +176,30 @@ def test_a_person_standing_just_beyond_d_h_between_the_robot_and_its_goal_is_gon
         assert closest >= D_H, f"{closest:.2f} m from someone while moving"
 
 
+def test_a_robot_facing_people_who_stand_between_it_and_its_goal_does_not_wait_for_good(passing_dir: Path) -> None:
+    """The end of a square crossing (social force, tuning seed 211, 20 people): people stand at their goals,
+    three of them 1.8 m ahead of the robot across its way. The progress objective's goals started at the
+    robot's projection, the collision potential outweighed their pull on the first nodes, and every period's
+    plan stood for a node and then went: the robot stood until the timeout. The goals now go on without a
+    robot that waits among people who stand, and it goes round them."""
+    c = humanmpc.load(passing_dir).controller()
+    people = np.array([[-1.11, 1.15, 0.0, 0.0], [0.20, 1.02, 0.0, 0.0], [0.75, 0.61, 0.0, 0.0],
+                       [0.15, 2.17, 0.0, 0.0]])
+    goal = (0.0, 4.0, 1.57)
+    for heading in (1.69, 1.2):
+        c.reset()
+        x, model, closest = np.array([-0.57, -0.63, heading, 0.0]), RobotModel(), np.inf
+        for k in range(250):
+            r = c.step(k * DT, pose=x[:3], v=x[3], goal=goal, people=people)
+            if r.goal_reached:
+                break
+            if abs(x[3]) > 0.05:
+                closest = min(closest, float(np.min(np.hypot(*(people[:, :2] - x[:2]).T))))
+            x = step(model, x, r.u, DT)
+        assert r.goal_reached, f"heading {heading}: at {np.round(x, 2)} after 25 s"
+        assert closest >= D_H, f"{closest:.2f} m from someone while moving"
+
+
 def test_the_guard_stops_a_moving_plan_only_when_no_plan_passes_its_tests(passing_dir: Path) -> None:
     """A plan that the guard would stop (speed and separation, the stop in time) is no choice while another
     passes: the candidates' choice applies the guard's tests of a moving plan to every plan. Before, the
