@@ -153,6 +153,22 @@ def test_the_candidates_run_in_the_first_period_of_an_episode_that_starts_elsewh
     assert first.candidates_ok == again.candidates_ok == 3, (first.candidates_ok, again.candidates_ok)
 
 
+def drive_among_standing_people(c: Controller, pose: tuple[float, float, float], goal: tuple[float, float, float],
+                                people: np.ndarray, seconds: float) -> tuple[bool, np.ndarray, float]:
+    """The controller from rest at pose in the project's plant: (goal reached within seconds, the final state,
+    the closest approach to anyone while moving faster than 0.05 m/s)."""
+    c.reset()
+    x, model, closest = np.array([*pose, 0.0]), RobotModel(), np.inf
+    for k in range(round(seconds / DT)):
+        r = c.step(k * DT, pose=x[:3], v=x[3], goal=goal, people=people)
+        if r.goal_reached:
+            return True, x, closest
+        if abs(x[3]) > 0.05:
+            closest = min(closest, float(np.min(np.hypot(*(people[:, :2] - x[:2]).T))))
+        x = step(model, x, r.u, DT)
+    return False, x, closest
+
+
 def test_a_person_standing_just_beyond_d_h_between_the_robot_and_its_goal_is_gone_round(passing_dir: Path) -> None:
     """The end of a square crossing (social force, tuning seed 147, 10 people): the people stand at their
     goals, one 0.52 m from the robot on the way to its goal. The progress objective's speed to track,
@@ -163,16 +179,8 @@ def test_a_person_standing_just_beyond_d_h_between_the_robot_and_its_goal_is_gon
                        [1.28, 0.64, 0.0, 0.0]])
     goal = (0.0, 4.0, 1.57)
     for heading in (1.22, 0.41):
-        c.reset()
-        x, model, closest = np.array([0.57, 2.39, heading, 0.0]), RobotModel(), np.inf
-        for k in range(150):
-            r = c.step(k * DT, pose=x[:3], v=x[3], goal=goal, people=people)
-            if r.goal_reached:
-                break
-            if abs(x[3]) > 0.05:
-                closest = min(closest, float(np.min(np.hypot(*(people[:, :2] - x[:2]).T))))
-            x = step(model, x, r.u, DT)
-        assert r.goal_reached, f"heading {heading}: at {np.round(x, 2)} after 15 s"
+        reached, x, closest = drive_among_standing_people(c, (0.57, 2.39, heading), goal, people, seconds=15.0)
+        assert reached, f"heading {heading}: at {np.round(x, 2)} after 15 s"
         assert closest >= D_H, f"{closest:.2f} m from someone while moving"
 
 
@@ -187,16 +195,8 @@ def test_a_robot_facing_people_who_stand_between_it_and_its_goal_does_not_wait_f
                        [0.15, 2.17, 0.0, 0.0]])
     goal = (0.0, 4.0, 1.57)
     for heading in (1.69, 1.2):
-        c.reset()
-        x, model, closest = np.array([-0.57, -0.63, heading, 0.0]), RobotModel(), np.inf
-        for k in range(250):
-            r = c.step(k * DT, pose=x[:3], v=x[3], goal=goal, people=people)
-            if r.goal_reached:
-                break
-            if abs(x[3]) > 0.05:
-                closest = min(closest, float(np.min(np.hypot(*(people[:, :2] - x[:2]).T))))
-            x = step(model, x, r.u, DT)
-        assert r.goal_reached, f"heading {heading}: at {np.round(x, 2)} after 25 s"
+        reached, x, closest = drive_among_standing_people(c, (-0.57, -0.63, heading), goal, people, seconds=25.0)
+        assert reached, f"heading {heading}: at {np.round(x, 2)} after 25 s"
         assert closest >= D_H, f"{closest:.2f} m from someone while moving"
 
 
