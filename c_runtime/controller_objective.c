@@ -165,12 +165,12 @@ static hm_real controller_lead(hm_controller *c, const hm_controller_input *cin,
 }
 
 /* The progress objective's goal per node (params.progress): node n's goal is the point of the path where
- * a robot that started at its projection now, plus the lead (above), would be at node n's time, going at the speed to track
- * (in->goal[3]: the cruising speed, lowered by speed and separation; not the measured speed, from which a
- * standing robot's goals would move off too slowly to ever start it) and braking at half the lower bound
- * to arrive at the goal at rest; heading: the path's there; speed: that speed. Motion that does not bring
- * the robot along its path falls behind these goals and costs; so does standing, once they have moved on.
- * Sets in->refs and in->has_refs. */
+ * a robot that started at its projection now, plus the lead (above), would be at node n's time, going at
+ * the speed to track (in->goal[3]: the cruising speed, lowered by speed and separation; not the measured
+ * speed, from which a standing robot's goals would move off too slowly to ever start it) and braking at half
+ * the lower bound to arrive at the goal at rest; heading: the path's there; speed: that speed. Motion that
+ * does not bring the robot along its path falls behind these goals and costs; so does standing, once they
+ * have moved on. Sets in->refs and in->has_refs, and c->lead. */
 HM_FUNC void controller_references(hm_controller *c, const hm_controller_input *cin, const hm_controller_goal *g)
 {
     hm_input *in = &c->in;

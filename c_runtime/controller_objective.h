@@ -24,7 +24,7 @@ HM_FUNC void controller_caller_restore(hm_controller *c, const controller_caller
 HM_FUNC void controller_solver_params(hm_controller *c, const hm_controller_goal *g);
 /* Where the path to the goal starts (a goal pose given alone: where the robot was when it got it). */
 HM_FUNC const hm_real *controller_origin(hm_controller *c, const hm_controller_input *cin);
-/* The progress objective's goal per node: c->in.refs, c->in.has_refs. */
+/* The progress objective's goal per node: c->in.refs, c->in.has_refs; updates the goals' lead (c->lead). */
 HM_FUNC void controller_references(hm_controller *c, const hm_controller_input *cin, const hm_controller_goal *g);
 /* c->in.humans_no_potential for the people the OCP sees (out->people_index). */
 HM_FUNC void controller_goal_people(hm_controller *c, const hm_controller_input *cin, const hm_controller_goal *g,
