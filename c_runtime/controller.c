@@ -25,10 +25,8 @@
 #include "ocp_qp.h"
 
 /* The progress objective's speed to track, lowered by speed and separation towards the goal, not below this
- * fraction of itself. Success on tuning seeds (100..139: circle_20, square_20, square_10, both crowd models;
- * 140..239: square_10 social force) with the fraction 0 / 0.3 / 0.5 / 0.75: 0.954 / 0.963 / 0.967 / 0.933
- * and 0.96 / 0.97 / 0.98 / 0.96; not lowered at all: square_10 0.95, with four people walking into a robot
- * stopped in time. The speed itself stays bounded by the OCP's constraints and the guard. */
+ * fraction of itself (chosen on tuning seeds: docs/evaluation.md, "How the defaults were chosen"). The speed
+ * itself stays bounded by the OCP's constraints and the guard. */
 #define CONTROLLER_PROGRESS_SPEED_FLOOR HM_R(0.5)
 
 /* 1 when every input is usable: counts within their capacities, numbers finite and not absurd. */
@@ -206,9 +204,9 @@ static int controller_plan(hm_controller *c, const hm_controller_input *cin, uns
     }
     /* A speed to track that the robot may not use towards its goal rewards the plan for spending it
      * elsewhere: with people between it and the goal, it circled at cruising speed. The progress objective
-     * spends it along the path only, and lowered to the bound it left the path's goals creeping beside a
-     * person who stood between the robot and its goal (0.06 m/s for 18 s, 4 of 100 square_10 episodes
-     * timed out): there it is lowered at most to CONTROLLER_PROGRESS_SPEED_FLOOR of itself. */
+     * spends it along the path only, and lowered all the way to the bound it left the path's goals creeping
+     * beside a person who stood between the robot and its goal, where the robot then stood: there it is
+     * lowered at most to CONTROLLER_PROGRESS_SPEED_FLOOR of itself. */
     {
         const hm_real dx = in->goal[0] - in->x0[0], dy = in->goal[1] - in->x0[1];
         const hm_real len = hm_sqrt(dx * dx + dy * dy);

@@ -113,15 +113,14 @@ HM_FUNC const hm_real *controller_origin(hm_controller *c, const hm_controller_i
 }
 
 /* The lead of the progress objective's goals. They start at the robot's projection, so node n's pull grows
- * with n: beside people standing 1.8 m ahead the collision potential outweighed it on the first nodes, and
- * every period's plan stood for a node and then went, while the robot stood until the timeout (square_20
- * social force, tuning seeds 140..239: 5 of 100 episodes, 12-24 s at a standstill). While the robot has gone
- * slower than half its speed to track for CONTROLLER_LEAD_WAIT and everyone within CONTROLLER_LEAD_NEAR of it
- * stands, the goals go on without it: the lead grows by the way it falls behind that speed, up to that speed
- * times CONTROLLER_LEAD_TIME; otherwise it decays with that time constant. Not while someone near walks:
- * there waiting is the way through, and a lead that pulled the robot on among walking people (a plain
- * first-order lag) let social-force people walk into it (circle_20 social force, the same seeds: success
- * 0.93 -> 0.80). */
+ * with n: beside people standing ahead the collision potential outweighs it on the first nodes, and a plan
+ * that stands for a node and then goes is planned again in every period while the robot stands for good.
+ * While the robot has gone slower than half its speed to track for CONTROLLER_LEAD_WAIT and everyone within
+ * CONTROLLER_LEAD_NEAR of it stands, the goals go on without it: the lead grows by the way it falls behind
+ * that speed, up to that speed times CONTROLLER_LEAD_TIME; otherwise it decays with that time constant. Not
+ * while someone near walks: there waiting is the way through, and a lead that pulls the robot on lets
+ * social-force people walk into it. The values were chosen on tuning seeds (docs/evaluation.md, "How the
+ * defaults were chosen"). */
 #define CONTROLLER_LEAD_TIME HM_R(2.0)   /* s */
 #define CONTROLLER_LEAD_WAIT HM_R(2.0)   /* s */
 #define CONTROLLER_LEAD_NEAR HM_R(2.0)   /* m */
