@@ -1,8 +1,9 @@
 """Figures of episodes in the spirit of the paper's (headless, Agg backend).
 
 * :func:`plot_episodes`: one map per episode given (robot path in its planner's colour, the people of
-  that episode, obstacles, start and goal, contacts marked); below, the distance to the nearest human
-  and the planner time over time, every episode in one plot each.
+  that episode, obstacles, start and goal, contacts marked); below, the distance to the nearest human,
+  the robot's speed (its protective stops shaded, contacts marked where they start, as on the map) and
+  the planner time over time, every episode in one plot each.
 * :func:`animate_episode`: an animated GIF of one episode (pillow writer).
 
 People and planners never share colours: planners are drawn in saturated categorical colours (MPC red,
@@ -31,6 +32,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle as CirclePatch
+from matplotlib.patches import Patch
 from matplotlib.patches import Polygon as PolygonPatch
 
 from ..sim.world import World
@@ -128,6 +130,32 @@ def draw_contacts(ax: Axes, log: EpisodeLog) -> None:
         ax.plot(xy[wall, 0], xy[wall, 1], ls="none", ms=9, zorder=6, **WALL_MARK)  # type: ignore[arg-type]
 
 
+def draw_speed(ax: Axes, log: EpisodeLog, colour: str) -> None:
+    """The robot's speed over time, the periods of a protective stop shaded and the contacts with people
+    marked where they start: what the robot did when someone came into contact (a stop before a contact at
+    the person's fault is the commonest story of a failed episode in a crowd)."""
+    v = log.states[:, 3]
+    ax.plot(log.times, v, color=colour, label=log.planner)
+    # each run of stopped periods k0..k1 - 1 spans times[k0] to times[k1]: its last period included
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], log.stops.astype(int), [0]))))
+    for k0, k1 in zip(edges[::2], edges[1::2], strict=True):
+        ax.axvspan(log.times[k0], log.times[k1], color=colour, alpha=0.18, lw=0)
+    robot, person = contact_starts(log)
+    if robot.size:
+        ax.plot(log.times[robot], v[robot], ls="none", marker="X", ms=9, mfc="black", mec="white", zorder=6)
+    if person.size:
+        ax.plot(log.times[person], v[person], ls="none", marker="X", ms=9, mfc="white", mec="black", zorder=6)
+
+
+def speed_legend_handles() -> list[Line2D | Patch]:
+    """The speed plot's legend: the stop shading (in each planner's colour) and the two contact marks."""
+    return [
+        Patch(color="0.5", alpha=0.3, label="protective stop"),
+        Line2D([], [], ls="none", marker="X", ms=8, mfc="black", mec="white", label="contact, robot's fault"),
+        Line2D([], [], ls="none", marker="X", ms=8, mfc="white", mec="black", label="contact, person's fault"),
+    ]
+
+
 def legend_handles(colour: str, label: str) -> list[Line2D]:
     """The map's legend: the robot's path, the people, the three contact marks, start and goal."""
     return [
@@ -191,10 +219,16 @@ def plot_episodes(logs: Sequence[EpisodeLog], path: str | Path, title: str | Non
     out = figure_path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     n = len(logs)
-    fig = plt.figure(figsize=(max(7.5, 5.2 * n), 11.5))
-    grid = fig.add_gridspec(3, n, height_ratios=[4.2, 1, 1])
-    ax_d = fig.add_subplot(grid[1, :])
-    ax_t = fig.add_subplot(grid[2, :], sharex=ax_d)
+    fig = plt.figure(figsize=(max(7.5, 5.2 * n), 12.5))
+    grid = fig.add_gridspec(2, n, height_ratios=[4.2, 3.0])
+    # the three plots over time in a grid of their own, close together: tight_layout spaces the rows of
+    # one grid alike, and the maps' legends below them would pull these apart
+    below = grid[1, :].subgridspec(3, 1, hspace=0.12)
+    ax_d = fig.add_subplot(below[0])
+    ax_v = fig.add_subplot(below[1], sharex=ax_d)
+    ax_t = fig.add_subplot(below[2], sharex=ax_d)
+    for ax_above in (ax_d, ax_v):
+        ax_above.tick_params(labelbottom=False)
     first = logs[0]
     for i, log in enumerate(logs):
         colour = planner_colour(log.planner, i)
@@ -203,6 +237,7 @@ def plot_episodes(logs: Sequence[EpisodeLog], path: str | Path, title: str | Non
         ax.set_title(f"{log.planner}" if n > 1 else (title or f"{first.scenario}, seed {first.seed}"), fontsize=10)
         xy = log.states[:, :2]
         ax_d.plot(log.times, human_distances(xy, log.humans, log.present), color=colour, label=log.planner)
+        draw_speed(ax_v, log, colour)
         ax_t.plot(log.times[1:], log.solve_ms, color=colour, label=log.planner)
     if n > 1:
         fig.suptitle(title or f"{first.scenario}, seed {first.seed}")
@@ -212,6 +247,9 @@ def plot_episodes(logs: Sequence[EpisodeLog], path: str | Path, title: str | Non
     ax_d.set_ylabel("nearest human [m]")
     ax_d.set_ylim(0, 4)
     ax_d.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    ax_v.set_ylabel("speed [m/s]")
+    ax_v.set_ylim(bottom=min(0.0, float(min(np.min(log.states[:, 3]) for log in logs))))
+    ax_v.legend(handles=speed_legend_handles(), fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     ax_t.set_ylabel("planner time [ms]")
     ax_t.set_xlabel("t [s]")
     fig.tight_layout()
