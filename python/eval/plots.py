@@ -219,8 +219,14 @@ def plot_episodes(logs: Sequence[EpisodeLog], path: str | Path, title: str | Non
     out = figure_path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     n = len(logs)
-    fig = plt.figure(figsize=(max(7.5, 5.2 * n), 12.5))
-    grid = fig.add_gridspec(2, n, height_ratios=[4.2, 3.0])
+    width = max(7.5, 5.2 * n)
+    # the maps' row as high as the widest world needs at the column's width (a corridor is flat), and
+    # their legends below them
+    aspect = max((log.world.bounds[3] - log.world.bounds[2]) / (log.world.bounds[1] - log.world.bounds[0])
+                 for log in logs)
+    map_height = min(0.75 * width / n * aspect, 7.0) + 1.5
+    fig = plt.figure(figsize=(width, map_height + 4.5))
+    grid = fig.add_gridspec(2, n, height_ratios=[map_height, 4.5])
     # the three plots over time in a grid of their own, close together: tight_layout spaces the rows of
     # one grid alike, and the maps' legends below them would pull these apart
     below = grid[1, :].subgridspec(3, 1, hspace=0.12)
