@@ -36,7 +36,7 @@ from matplotlib.patches import Patch
 from matplotlib.patches import Polygon as PolygonPatch
 
 from ..sim.world import World
-from .episode import EpisodeLog
+from .episode import EpisodeLog, FloatArray
 from .metrics import D_TH, human_distances, person_distances, rising_edges, robot_at_fault
 
 PLANNER_COLOURS = {"mpc": "tab:red", "dwb": "tab:blue", "mpc_paper": "tab:orange"}
@@ -116,16 +116,32 @@ def wall_contact_starts(log: EpisodeLog) -> np.ndarray:
 
 
 WALL_MARK = {"marker": "s", "mfc": "orange", "mec": "black"}
+# the contacts with people, by fault, on the map and on the speed plot alike
+CONTACT_MARKS = (
+    ("contact, robot's fault", {"marker": "X", "mfc": "black", "mec": "white"}),
+    ("contact, person's fault", {"marker": "X", "mfc": "white", "mec": "black"}),
+)
+
+
+def draw_contact_marks(ax: Axes, x: FloatArray, y: FloatArray, log: EpisodeLog, ms: float) -> None:
+    """Each contact with a person marked at (x, y)[its first sample], by fault (CONTACT_MARKS)."""
+    for (_, mark), starts in zip(CONTACT_MARKS, contact_starts(log), strict=True):
+        if starts.size:
+            ax.plot(x[starts], y[starts], ls="none", ms=ms, zorder=6, **mark)  # type: ignore[arg-type]
+
+
+def contact_legend_handles(ms: float) -> list[Line2D]:
+    """The legend entries of the two contact marks."""
+    return [
+        Line2D([], [], ls="none", ms=ms, label=label, **mark)  # type: ignore[arg-type]
+        for label, mark in CONTACT_MARKS
+    ]
 
 
 def draw_contacts(ax: Axes, log: EpisodeLog) -> None:
-    robot, person = contact_starts(log)
     wall = wall_contact_starts(log)
     xy = log.states[:, :2]
-    if robot.size:
-        ax.plot(xy[robot, 0], xy[robot, 1], ls="none", marker="X", ms=11, mfc="black", mec="white", zorder=6)
-    if person.size:
-        ax.plot(xy[person, 0], xy[person, 1], ls="none", marker="X", ms=11, mfc="white", mec="black", zorder=6)
+    draw_contact_marks(ax, xy[:, 0], xy[:, 1], log, ms=11)
     if wall.size:
         ax.plot(xy[wall, 0], xy[wall, 1], ls="none", ms=9, zorder=6, **WALL_MARK)  # type: ignore[arg-type]
 
@@ -140,20 +156,12 @@ def draw_speed(ax: Axes, log: EpisodeLog, colour: str) -> None:
     edges = np.flatnonzero(np.diff(np.concatenate(([0], log.stops.astype(int), [0]))))
     for k0, k1 in zip(edges[::2], edges[1::2], strict=True):
         ax.axvspan(log.times[k0], log.times[k1], color=colour, alpha=0.18, lw=0)
-    robot, person = contact_starts(log)
-    if robot.size:
-        ax.plot(log.times[robot], v[robot], ls="none", marker="X", ms=9, mfc="black", mec="white", zorder=6)
-    if person.size:
-        ax.plot(log.times[person], v[person], ls="none", marker="X", ms=9, mfc="white", mec="black", zorder=6)
+    draw_contact_marks(ax, log.times, v, log, ms=9)
 
 
 def speed_legend_handles() -> list[Line2D | Patch]:
     """The speed plot's legend: the stop shading (in each planner's colour) and the two contact marks."""
-    return [
-        Patch(color="0.5", alpha=0.3, label="protective stop"),
-        Line2D([], [], ls="none", marker="X", ms=8, mfc="black", mec="white", label="contact, robot's fault"),
-        Line2D([], [], ls="none", marker="X", ms=8, mfc="white", mec="black", label="contact, person's fault"),
-    ]
+    return [Patch(color="0.5", alpha=0.3, label="protective stop"), *contact_legend_handles(ms=8)]
 
 
 def legend_handles(colour: str, label: str) -> list[Line2D]:
@@ -162,8 +170,7 @@ def legend_handles(colour: str, label: str) -> list[Line2D]:
         Line2D([], [], color=colour, lw=2.0, label=label),
         Line2D([], [], color=PEOPLE_COLOUR, lw=1.0, marker=r"$\rightarrow$", ms=9,
                label="people, one shade of green each\n(circle: first seen; arrows: walking)"),
-        Line2D([], [], ls="none", marker="X", ms=9, mfc="black", mec="white", label="contact, robot's fault"),
-        Line2D([], [], ls="none", marker="X", ms=9, mfc="white", mec="black", label="contact, person's fault"),
+        *contact_legend_handles(ms=9),
         Line2D([], [], ls="none", ms=8, label="contact with a wall or obstacle", **WALL_MARK),  # type: ignore[arg-type]
         Line2D([], [], ls="none", marker="o", ms=8, mfc="white", mec="k", label="robot's start"),
         Line2D([], [], ls="none", marker="*", ms=12, color="gold", mec="k", label="goal"),
