@@ -12,31 +12,27 @@ and the dwb) and circle_20, square_20 and square_10 with social force (the mpc w
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 import sys
 from collections import defaultdict
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
 from humanmpc.codegen.params import PARAMS
+from humanmpc.eval.store import ResultStore
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-Row = dict[str, str]
+Row = dict[str, Any]
 TIME_BAR = 1.2
 SUCCESS_BAR_20 = 0.85
 SUCCESS_BAR_10 = 0.95
 DEFAULT = "default"
 DEFAULTS = {p.name: p.default for p in PARAMS}
-
-
-def campaign_rows(folder: Path) -> list[Row]:
-    with open(folder / "runs.csv", newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def setting(row: Row) -> str:
@@ -51,11 +47,11 @@ def mean(values: list[float]) -> float:
 
 
 def arrival_time(rows: list[Row]) -> float:
-    return mean([float(r["time_to_goal"]) for r in rows if r["success"] == "True"])
+    return mean([r["time_to_goal"] for r in rows if r["success"]])
 
 
 def success(rows: list[Row]) -> float:
-    return mean([1.0 if r["success"] == "True" else 0.0 for r in rows])
+    return mean([1.0 if r["success"] else 0.0 for r in rows])
 
 
 def collect(root: Path) -> tuple[dict[str, dict[str, float]], dict[str, float]]:
@@ -64,10 +60,8 @@ def collect(root: Path) -> tuple[dict[str, dict[str, float]], dict[str, float]]:
     c10: dict[tuple[str, str], list[Row]] = defaultdict(list)
     dense: dict[tuple[str, str], list[Row]] = defaultdict(list)
     dwb: dict[str, list[Row]] = defaultdict(list)
-    for folder in sorted(root.iterdir()):
-        if not (folder / "runs.csv").is_file():
-            continue
-        for r in campaign_rows(folder):
+    for folder in sorted(p for p in root.iterdir() if p.is_dir()):
+        for r in ResultStore(folder).read_rows():  # none in a folder that holds no campaign
             if r["planner"] == "dwb":
                 if r["scenario"] == "crowdnav_circle_10":
                     dwb[r["crowd"]].append(r)
@@ -78,7 +72,7 @@ def collect(root: Path) -> tuple[dict[str, dict[str, float]], dict[str, float]]:
     dwb_time = {crowd: arrival_time(rs) for crowd, rs in dwb.items()}
     points: dict[str, dict[str, float]] = defaultdict(dict)
     for (name, crowd), rs in c10.items():
-        points[name][f"time {crowd}"] = arrival_time(rs) / dwb_time[crowd]
+        points[name][f"time {crowd}"] = arrival_time(rs) / dwb_time.get(crowd, math.nan)
         if crowd == "social_force":
             points[name]["crowdnav_circle_10"] = success(rs)
     for (name, scenario), rs in dense.items():
