@@ -151,17 +151,21 @@ def _cmd_keys(args: argparse.Namespace) -> int:
     return 0
 
 
+# The default spec is named "paper" (its C prefix) but is the humanmpc preset, which users confuse.
+SPEC_HELP = "YAML spec file (default: the built-in default spec, named paper; not `preset: paper`)"
+
+
 def add_generator_commands(sub: argparse._SubParsersAction) -> None:
     """The generator's subcommands: check, generate, ros, build, info, keys."""
     p = sub.add_parser("check", help="validate a spec and print it resolved (defaults filled in)",
                        description="Validate SPEC (or the built-in default spec) and print the resolved spec.")
-    p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
+    p.add_argument("spec", nargs="?", help=SPEC_HELP)
     p.set_defaults(func=_cmd_check)
 
     p = sub.add_parser("generate", help="generate the C solver package of a spec",
                        description="Generate the C solver package of SPEC (or of the built-in default spec). "
                        "The folder is written atomically: on failure nothing is left behind.")
-    p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
+    p.add_argument("spec", nargs="?", help=SPEC_HELP)
     p.add_argument("-o", "--output", type=output_dir, help="output folder (default: generated/<name>)")
     p.add_argument("--force", action="store_true", help="replace an existing generated folder")
     p.set_defaults(func=_cmd_generate)

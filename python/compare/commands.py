@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..codegen.cli import output_dir, positive_int
+from ..codegen.cli import SPEC_HELP, output_dir, positive_int
 from ..codegen.spec import SpecError, load_spec
 from .report import add_compare_arguments
 
@@ -45,7 +45,7 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("bench", help="time the real-time iteration in random crowds",
                        description="Generate one solver per crowd size and time its RTI steps in seeded "
                        "closed loops (humans at constant velocity, one obstacle near the path).")
-    p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
+    p.add_argument("spec", nargs="?", help=SPEC_HELP)
     p.add_argument("--humans", default="5,10,20,30", help="crowd sizes N_h (default: 5,10,20,30)")
     p.add_argument("--seeds", type=positive_int, default=3, help="closed loops per crowd size (default: 3)")
     p.add_argument("--steps", type=positive_int, default=300, help="RTI steps per closed loop (default: 300)")

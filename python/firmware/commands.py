@@ -9,7 +9,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-from ..codegen.cli import non_negative_int, output_dir, positive_int
+from ..codegen.cli import SPEC_HELP, non_negative_int, output_dir, positive_int
 from ..codegen.spec import SpecError, load_spec
 from ..status import OUTCOME_NAMES, STOP_REASONS
 from .controller import DEADLINE_PROBE_MS, ControllerAgreement, ControllerRun, run_controller_firmware
@@ -151,7 +151,7 @@ def add_firmware_parser(subparsers: Any) -> None:
         "flash, RAM and instructions per RTI step (QEMU icount: instructions, not cycles) with the agreement "
         "with the host library; with --controller-steps the same for the navigation controller's replay image, "
         "optionally linked into the RAM of a smaller part (--ram-kib).")
-    p.add_argument("spec", nargs="?", help="YAML spec file (default: the built-in paper spec)")
+    p.add_argument("spec", nargs="?", help=SPEC_HELP)
     p.add_argument("--humans", default="5,10,30", help="N_h values (default 5,10,30)")
     p.add_argument("--cpus", default="cortex-m4,cortex-m7", help="CPUs (default cortex-m4,cortex-m7)")
     p.add_argument("--precisions", default="double,float", help="precisions (default double,float)")
