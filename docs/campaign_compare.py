@@ -8,35 +8,25 @@ repository root after the two campaigns (the commands are in docs/evaluation.md)
 
 from __future__ import annotations
 
-import csv
 import math
 import sys
 from collections import defaultdict
 from pathlib import Path
+from typing import Any
 
-Row = dict[str, str]
+from humanmpc.eval.stats import wilson
+from humanmpc.eval.store import ResultStore
+
+Row = dict[str, Any]
 
 
 def rows(folder: str) -> list[Row]:
-    with open(Path(folder) / "runs.csv", newline="") as f:
-        return list(csv.DictReader(f))
-
-
-def number(x: str) -> float:
-    return 1.0 if x == "True" else 0.0 if x == "False" else float(x)
+    return ResultStore(Path(folder)).read_rows()
 
 
 def mean(values: list[float]) -> float:
+    """A NaN (a cell without a success) makes the mean NaN: an overall figure that skipped it would flatter."""
     return sum(values) / len(values) if values else math.nan
-
-
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    if n == 0:
-        return math.nan, math.nan
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def cells(data: list[Row], planner: str | None) -> dict[tuple[str, str], list[Row]]:
@@ -48,16 +38,16 @@ def cells(data: list[Row], planner: str | None) -> dict[tuple[str, str], list[Ro
 
 
 def summary(group: list[Row], dwb: list[Row]) -> dict[str, float]:
-    ok = [r for r in group if r["success"] == "True"]
-    ok_dwb = [r for r in dwb if r["success"] == "True"]
+    ok = [r for r in group if r["success"]]
+    ok_dwb = [r for r in dwb if r["success"]]
     return {
         "n": len(group), "k": len(ok), "success": len(ok) / len(group),
-        "path": mean([number(r["path_length"]) for r in ok]) / mean([number(r["path_length"]) for r in ok_dwb]),
-        "time": mean([number(r["time_to_goal"]) for r in ok]) / mean([number(r["time_to_goal"]) for r in ok_dwb]),
-        "freezing": mean([number(r["freezing_time"]) for r in group]),
-        "robot_fault": sum(number(r["robot_fault_contacts"]) for r in group),
-        "person_fault": sum(number(r["person_fault_contacts"]) for r in group),
-        "timeout": mean([number(r["timeout"]) for r in group]),
+        "path": mean([r["path_length"] for r in ok]) / mean([r["path_length"] for r in ok_dwb]),
+        "time": mean([r["time_to_goal"] for r in ok]) / mean([r["time_to_goal"] for r in ok_dwb]),
+        "freezing": mean([float(r["freezing_time"]) for r in group]),
+        "robot_fault": sum(float(r["robot_fault_contacts"]) for r in group),
+        "person_fault": sum(float(r["person_fault_contacts"]) for r in group),
+        "timeout": mean([float(r["timeout"]) for r in group]),
     }
 
 
@@ -75,15 +65,15 @@ def main() -> None:
         totals["after"].append(a)
         totals["before"].append(b)
         totals["dwb"].append(d)
-        lo, hi = wilson(int(a["k"]), int(a["n"]))
-        print(f"| {key[0]} | {key[1]} | {a['success']:.2f} [{lo:.2f}, {hi:.2f}] | {b['success']:.2f} | "
+        iv = wilson(int(a["k"]), int(a["n"]))
+        print(f"| {key[0]} | {key[1]} | {a['success']:.2f} [{iv.low:.2f}, {iv.high:.2f}] | {b['success']:.2f} | "
               f"{d['success']:.2f} | {a['path']:.2f} ({b['path']:.2f}) | {a['time']:.2f} ({b['time']:.2f}) | "
               f"{a['freezing']:.1f} ({b['freezing']:.1f}) | {a['robot_fault']:.0f} / {a['person_fault']:.0f} "
               f"({b['robot_fault']:.0f} / {b['person_fault']:.0f}) |")
     for name, t in totals.items():
         k, n = sum(int(x["k"]) for x in t), sum(int(x["n"]) for x in t)
-        lo, hi = wilson(k, n)
-        print(f"{name}: {n} episodes, success {k / n:.3f} [{lo:.3f}, {hi:.3f}], timeouts "
+        iv = wilson(k, n)
+        print(f"{name}: {n} episodes, success {k / n:.3f} [{iv.low:.3f}, {iv.high:.3f}], timeouts "
               f"{mean([x['timeout'] for x in t]):.3f}, path / DWB {mean([x['path'] for x in t]):.2f} "
               f"(worst cell {max(x['path'] for x in t):.2f}), time / DWB {mean([x['time'] for x in t]):.2f} "
               f"(worst cell {max(x['time'] for x in t):.2f}), freezing {mean([x['freezing'] for x in t]):.2f} s, "

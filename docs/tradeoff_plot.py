@@ -22,6 +22,7 @@ from typing import Any
 import matplotlib
 
 from humanmpc.codegen.params import PARAMS
+from humanmpc.eval.stats import mean_interval, wilson
 from humanmpc.eval.store import ResultStore
 
 matplotlib.use("Agg")
@@ -42,16 +43,12 @@ def setting(row: Row) -> str:
     return ", ".join(f"{k} {v:g}" for k, v in sorted(params.items())) or DEFAULT
 
 
-def mean(values: list[float]) -> float:
-    return sum(values) / len(values) if values else math.nan
-
-
 def arrival_time(rows: list[Row]) -> float:
-    return mean([r["time_to_goal"] for r in rows if r["success"]])
+    return mean_interval([r["time_to_goal"] for r in rows if r["success"]]).value
 
 
 def success(rows: list[Row]) -> float:
-    return mean([1.0 if r["success"] else 0.0 for r in rows])
+    return wilson(sum(bool(r["success"]) for r in rows), len(rows)).value
 
 
 def collect(root: Path) -> tuple[dict[str, dict[str, float]], dict[str, float]]:
